@@ -1,0 +1,58 @@
+// backlash — command-line entry point.
+//
+// Every subcommand registers itself (cli/commands.hpp).  Errors become one line
+// on stderr, "backlash: error: <what>", and the exit code tells their kind:
+//   0  success, and --help (CLI11 prints it through app.exit)
+//   2  bad usage or bad input (CLI11 parse errors, UsageError, CaseFileError)
+//   1  any other failure
+// CLI11's own failure printer uses two lines and exit codes above 100; parse
+// errors are reported here in the one-line form with exit code 2 instead.
+#include "commands.hpp"
+
+#include "backlash/model/case_spec.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <exception>
+#include <iostream>
+#include <string>
+
+namespace {
+
+constexpr int exit_code_for_bad_input = 2;
+constexpr int exit_code_for_failure = 1;
+
+/// Prints "backlash: error: <message>" as exactly one line on stderr.
+int report_error(std::string message, int exit_code) {
+  for (char& character : message)
+    if (character == '\n' || character == '\r') character = ' ';
+  while (!message.empty() && message.back() == ' ') message.pop_back();
+  std::cerr << "backlash: error: " << message << '\n';
+  return exit_code;
+}
+
+}  // namespace
+
+int main(int argument_count, char** arguments) {
+  CLI::App app{
+      "backlash — exact analysis of servo systems with gear backlash: closed-form segment solutions, "
+      "dividing lines, limit cycles and step responses for the thesis cases I..VIII or any case file."};
+  app.require_subcommand(1);
+
+  backlash::cli::register_derive_command(app);
+  backlash::cli::register_report_command(app);
+
+  try {
+    app.parse(argument_count, arguments);
+  } catch (const CLI::ParseError& parse_error) {
+    if (parse_error.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(parse_error);
+    return report_error(std::string(parse_error.what()) + " (run with --help for usage)", exit_code_for_bad_input);
+  } catch (const backlash::cli::UsageError& usage_error) {
+    return report_error(usage_error.what(), exit_code_for_bad_input);
+  } catch (const backlash::model::CaseFileError& case_file_error) {
+    return report_error(case_file_error.what(), exit_code_for_bad_input);
+  } catch (const std::exception& other_error) {
+    return report_error(other_error.what(), exit_code_for_failure);
+  }
+  return 0;
+}

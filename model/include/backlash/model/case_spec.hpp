@@ -1,0 +1,87 @@
+// backlash/model/case_spec.hpp — a servo-with-backlash case, as exact rationals.
+//
+// A case file (TOML, schema in ../shared/DESIGN.md §3) describes the thesis's
+// two-body system (gear ratio N = 1):
+//   contact mode  (Jm+JL)·θo'' + (Fm+FL)·θo' + K·θo = K·θR        (eqs. 6, 15, 25)
+//   free load     JL·θL'' + FL·θL' = 0                              (eq. 17)
+//   free motor    Jm·θm'' + Fm·θm' + K·θm = K·θR   (output at motor, eq. 16)
+//                 Jm·θm'' + Fm·θm' = K·(θR − θL)    (output at load,  eq. 39)
+// with total backlash b.  Every number is exact: the decimal 0.3 as written in
+// the file is the rational 3/10, never the double nearest to it.
+//
+// This library has no GiNaC dependency: numeric/ uses it as well as symbolic/.
+#pragma once
+
+#include <boost/multiprecision/cpp_int.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace backlash::model {
+
+using Rational = boost::multiprecision::cpp_rational;
+
+enum class MeasuredAt { Motor, Load };
+
+/// An optional step experiment: start at rest in contact with θo = θR − step.
+struct Experiment {
+  Rational step;
+  std::optional<Rational> t_end;
+};
+
+struct CaseSpec {
+  std::string id;            ///< "I".."VIII" for thesis cases, else the file stem
+  std::string name;          ///< the file's `name`
+  std::filesystem::path source;  ///< file it was read from
+  MeasuredAt measured_at = MeasuredAt::Load;
+  Rational K;                ///< loop gain
+  Rational backlash;         ///< total backlash b (contact faces at ±b/2)
+  Rational reference;        ///< θR
+  Rational Jm, Fm;           ///< motor-side inertia and viscous friction
+  Rational JL, FL;           ///< load inertia and viscous friction
+  std::optional<Experiment> experiment;
+};
+
+/// A bad case file. what() is one line: "FILE:LINE: KEY: problem".
+class CaseFileError : public std::runtime_error {
+ public:
+  CaseFileError(std::filesystem::path file, long line, std::string key, const std::string& problem);
+  const std::filesystem::path& file() const { return file_; }
+  long line() const { return line_; }
+  const std::string& key() const { return key_; }
+
+ private:
+  std::filesystem::path file_;
+  long line_;
+  std::string key_;
+};
+
+/// Strict loader: unknown or missing keys, non-positive inertia, negative
+/// friction/backlash/gain, non-finite or non-numeric values → CaseFileError.
+/// Decimals as written become exact rationals (0.3 → 3/10); strings "p/q" and
+/// integers are accepted.
+CaseSpec load_case_file(const std::filesystem::path& file);
+
+/// The eight thesis cases, in thesis order: I, II, ..., VIII.
+const std::vector<std::string>& thesis_case_ids();
+
+/// Folder holding I.toml … VIII.toml: $BACKLASH_CASES_DIR if set, else the
+/// source tree's cases/ (compiled in).
+std::filesystem::path thesis_cases_dir();
+
+/// CASE = a thesis id ("V", case-insensitive) or the path of a case file.
+/// Unknown id that is not an existing file → CaseFileError naming it.
+CaseSpec load_case(const std::string& case_or_path);
+
+/// Exact text "p/q" (or "p" when q = 1), parseable by GiNaC's numeric(const char*).
+std::string to_string(const Rational& value);
+
+/// Nearest double.
+double to_double(const Rational& value);
+
+const char* to_string(MeasuredAt where);
+
+}  // namespace backlash::model
