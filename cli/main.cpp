@@ -41,6 +41,8 @@ int main(int argument_count, char** arguments) {
 
   backlash::cli::register_derive_command(app);
   backlash::cli::register_report_command(app);
+  backlash::cli::register_codegen_command(app);
+  backlash::cli::register_validate_command(app);
 
   try {
     app.parse(argument_count, arguments);
