@@ -1,0 +1,64 @@
+// backlash/numeric/first_crossing.hpp — the first time a closed-form signal
+// reaches a level, found so that no earlier crossing can be missed.
+//
+// Witness functions (after Drake): every event of the hybrid model is the
+// first zero of a witness w(t) = eᵀx(t) − level, where x(t) is a segment's
+// exact state and x' = A x + c its linear ODE:
+//   gap closure   w = θL − θm − (±b or 0)     (free mode)
+//   separation    w = Tc = JL·θ̈ + FL·θ̇         (contact mode)
+// Sampling alone cannot guarantee the first zero (a grazing approach or a
+// double crossing can hide between two samples, the failure of scipy's
+// solve_ivp), so the search is certified.  With z = x' (which obeys z' = A z,
+// so ‖z(t)‖∞ ≤ e^{‖A‖∞(t−a)}‖z(a)‖∞), on [a, b] (h = b − a) it bounds
+//   |w'''| = |eᵀA²z| ≤ ‖eᵀA²‖₁ e^{‖A‖h} ‖z(a)‖∞,
+// then |w''| ≤ M2 and |w'| ≤ M1 on [a, b] from the end values, and
+//   – excludes the interval when w(a), w(b) have one sign and |w(a)| + |w(b)| > h·M1;
+//   – accepts it as monotone when w'(a), w'(b) have one sign and (|w'(a)| + |w'(b)| − h·M2)/2 > 0,
+//     and then finds its single root (if w changes sign) with Boost.Math's toms748;
+//   – otherwise bisects, always examining the left half first.
+// An interval that can be neither excluded nor certified down to `min_interval`
+// is a grazing contact (w touches the level): it is reported as such.
+#pragma once
+
+#include <Eigen/Dense>
+
+#include <functional>
+#include <optional>
+
+namespace backlash::numeric {
+
+/// w(t) = eᵀx(t) − level for a linear segment x' = A x + c with exact x(t).
+struct LinearWitness {
+  Eigen::MatrixXd A;
+  Eigen::VectorXd c;
+  Eigen::RowVectorXd e;
+  double level = 0;
+  std::function<Eigen::VectorXd(double)> state;  ///< exact x(t) (a validated closed form)
+  /// Optional: w(t) + level computed directly by the closed form (e.g. the gap,
+  /// free of the cancellation in θL − θm); otherwise eᵀx(t).
+  std::function<double(double)> value;
+};
+
+struct Crossing {
+  double t = 0;
+  bool grazing = false;     ///< touched the level without crossing it
+  long intervals = 0;       ///< intervals examined (cost)
+};
+
+struct CrossingOptions {
+  double time_tolerance = 1e-14;  ///< toms748 stopping width, relative to t
+  double min_interval = 1e-11;    ///< below this an uncertified interval is a grazing contact
+  long max_intervals = 2'000'000; ///< guard: then std::runtime_error (never a hang)
+};
+
+/// For a witness that starts with w = w' = w'' = 0 at t = 0 (the gap on the
+/// separation line): a time t0 > 0 such that w is certified non-zero on
+/// (0, t0] (its third derivative keeps its sign there: |w'''(0)| > t0·sup|w''''|)
+/// and |w(t0)| ≈ noise; nothing when w'''(0) = 0.
+std::optional<double> certified_departure(const LinearWitness& witness, double noise);
+
+/// First t in (t_begin, t_end] with w(t) = 0, or nothing.
+std::optional<Crossing> first_crossing(const LinearWitness& witness, double t_begin, double t_end,
+                                       const CrossingOptions& options = {});
+
+}  // namespace backlash::numeric

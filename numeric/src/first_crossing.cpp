@@ -1,0 +1,108 @@
+#include "backlash/numeric/first_crossing.hpp"
+
+#include <boost/math/tools/roots.hpp>
+
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+namespace backlash::numeric {
+
+namespace {
+
+struct Sample {
+  double t, w, w1, w2, rate_norm;  // w and its first two derivatives, ‖x'(t)‖∞
+};
+
+struct Witness {
+  const LinearWitness& lw;
+  Eigen::RowVectorXd eA, eA2, eA3;
+  double eAc, eA2c, norm_A, norm_c, norm_eA2, norm_eA3;
+
+  explicit Witness(const LinearWitness& w) : lw(w) {
+    eA = w.e * w.A;
+    eA2 = eA * w.A;
+    eA3 = eA2 * w.A;
+    eAc = eA.dot(w.c);
+    eA2c = eA2.dot(w.c);
+    norm_A = w.A.cwiseAbs().rowwise().sum().maxCoeff();
+    norm_c = w.c.cwiseAbs().maxCoeff();
+    norm_eA2 = eA2.cwiseAbs().sum();
+    norm_eA3 = eA3.cwiseAbs().sum();
+  }
+
+  Sample at(double t) const {
+    const Eigen::VectorXd x = lw.state(t);
+    const double w = (lw.value ? lw.value(t) : lw.e.dot(x)) - lw.level;
+    const double w1 = eA.dot(x) + lw.e.dot(lw.c);
+    const double w2 = eA2.dot(x) + eAc;
+    const Eigen::VectorXd z = lw.A * x + lw.c;  // x' obeys z' = A z
+    return {t, w, w1, w2, z.cwiseAbs().maxCoeff()};
+  }
+
+  // sup |w'''| on [a.t, a.t + h]: w''' = eA² z and ‖z(t)‖ ≤ e^{‖A‖(t−a)} ‖z(a)‖.
+  double third_bound(const Sample& a, double h) const { return norm_eA2 * std::exp(norm_A * h) * a.rate_norm; }
+};
+
+bool same_sign(double x, double y) { return (x > 0 && y > 0) || (x < 0 && y < 0); }
+
+}  // namespace
+
+std::optional<double> certified_departure(const LinearWitness& witness, double noise) {
+  const Witness W(witness);
+  const Eigen::VectorXd x0 = witness.state(0);
+  const double third = W.eA3.dot(x0) + W.eA2c;  // w'''(0)
+  if (third == 0 || !std::isfinite(third)) return std::nullopt;
+  // w'''' = eA³ z with ‖z(t)‖ ≤ e^{‖A‖t} ‖z(0)‖.
+  const double z0 = (witness.A * x0 + witness.c).cwiseAbs().maxCoeff();
+  double t0 = std::cbrt(6 * noise / std::fabs(third));
+  for (int attempt = 0; attempt < 60; ++attempt, t0 *= 0.5)
+    if (std::fabs(third) > t0 * W.norm_eA3 * std::exp(W.norm_A * t0) * z0) return t0;
+  return std::nullopt;
+}
+
+std::optional<Crossing> first_crossing(const LinearWitness& witness, double t_begin, double t_end,
+                                       const CrossingOptions& options) {
+  if (!(t_end > t_begin)) return std::nullopt;
+  const Witness W(witness);
+  long examined = 0;
+  // Depth-first, left half first: a stack of intervals whose top is the leftmost.
+  std::vector<std::pair<Sample, Sample>> stack;
+  stack.push_back({W.at(t_begin), W.at(t_end)});
+  while (!stack.empty()) {
+    if (++examined > options.max_intervals)
+      throw std::runtime_error("first_crossing: interval budget exhausted (pathological witness)");
+    auto [a, b] = stack.back();
+    stack.pop_back();
+    if (!std::isfinite(a.w) || !std::isfinite(b.w)) throw std::runtime_error("first_crossing: non-finite witness");
+    if (a.w == 0 && a.t > t_begin) return Crossing{a.t, false, examined};
+    const double h = b.t - a.t;
+    const double M3 = W.third_bound(a, h);
+    const double M2 = 0.5 * (std::fabs(a.w2) + std::fabs(b.w2) + h * M3);
+    const double M1 = 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) + h * M2);
+    const bool sign_change = !same_sign(a.w, b.w);
+    if (!sign_change && std::fabs(a.w) + std::fabs(b.w) > h * M1) continue;  // excluded
+    const bool monotone = same_sign(a.w1, b.w1) && 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) - h * M2) > 0;
+    if (monotone || h < options.min_interval) {
+      if (sign_change) {
+        if (b.w == 0) return Crossing{b.t, false, examined};
+        const auto f = [&](double t) { return W.at(t).w; };
+        boost::uintmax_t iterations = 200;
+        const double tolerance = options.time_tolerance;
+        const auto root = boost::math::tools::toms748_solve(
+            f, a.t, b.t, a.w, b.w,
+            [tolerance](double lo, double hi) { return hi - lo <= tolerance * std::max(1.0, std::fabs(hi)); }, iterations);
+        return Crossing{0.5 * (root.first + root.second), false, examined};
+      }
+      if (monotone) continue;  // monotone without a sign change: no root
+      // Uncertified down to the resolution: the witness touches the level here.
+      return Crossing{std::fabs(a.w) <= std::fabs(b.w) ? a.t : b.t, true, examined};
+    }
+    const Sample m = W.at(a.t + 0.5 * h);
+    stack.push_back({m, b});
+    stack.push_back({a, m});
+  }
+  return std::nullopt;
+}
+
+}  // namespace backlash::numeric
