@@ -2,6 +2,7 @@
 
 #include "backlash/numeric/first_crossing.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
+#include "gap_events.hpp"
 
 #include <boost/math/tools/minima.hpp>
 
@@ -61,23 +62,15 @@ DividingLinePoint dividing_line_point(const ValidatedEvaluator& evaluator, doubl
   DividingLinePoint point;
   point.dtheta_m0 = v0;
   if (v0 == 0 || p.backlash <= 0) return point;
-  const double horizon = horizon_of(p, options);
-  const double face = std::copysign(p.backlash, v0);
-  const auto opposite = first_crossing(gap_witness(evaluator, v0, face), 0, horizon);
-  const std::optional<double> t0 = return_search_start(evaluator, v0);
-  std::optional<Crossing> back;
-  if (t0) back = first_crossing(gap_witness(evaluator, v0, 0), *t0, opposite ? opposite->t : horizon);
-  std::optional<Crossing> event;
-  if (back && (!opposite || back->t < opposite->t)) {
-    event = back;
-    point.status = RecombinationStatus::Recontact;
-  } else if (opposite) {
-    event = opposite;
-    point.status = RecombinationStatus::Recombination;
-  }
+  const LinearWitness gap = gap_witness(evaluator, v0, 0);
+  const double scale = std::max({1.0, std::fabs(p.theta_R), std::fabs(evaluator.cot_phi() * v0)});
+  const auto event = detail::first_gap_event(free_mode_segment(p), gap.state, gap.value, std::copysign(p.backlash, v0),
+                                             horizon_of(p, options), scale);
   if (!event) return point;
-  point.t = event->t;
-  point.grazing = event->grazing;
+  point.status = event->kind == detail::GapEventKind::FaceLeft ? RecombinationStatus::Recontact
+                                                               : RecombinationStatus::Recombination;
+  point.t = event->crossing.t;
+  point.grazing = event->crossing.grazing;
   const FreeState f = evaluator.free_state(point.t, v0);
   point.theta_m = f.theta_m;
   point.dtheta_m = f.dtheta_m;

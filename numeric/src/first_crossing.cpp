@@ -51,10 +51,19 @@ bool same_sign(double x, double y) { return (x > 0 && y > 0) || (x < 0 && y < 0)
 std::optional<double> certified_departure(const LinearWitness& witness, double noise) {
   const Witness W(witness);
   const Eigen::VectorXd x0 = witness.state(0);
-  const double third = W.eA3.dot(x0) + W.eA2c;  // w'''(0)
+  const double z0 = (witness.A * x0 + witness.c).cwiseAbs().maxCoeff();  // ‖x'(0)‖, with ‖x'(t)‖ ≤ e^{‖A‖t} z0
+  const double second = W.eA.dot(witness.A * x0 + witness.c);           // w''(0) = eA x'(0)
+  const double third = W.eA2.dot(witness.A * x0 + witness.c);           // w'''(0) = eA² x'(0)
+  const double scale = std::max(std::fabs(second), 1e-300);
+  // w'' dominant: |w''(0)| > t0 sup|w'''|, sup|w'''| ≤ ‖eA²‖ e^{‖A‖t0} z0.
+  if (std::fabs(second) > 1e-12 * std::max(1.0, z0)) {
+    double t0 = std::sqrt(2 * noise / scale);
+    for (int attempt = 0; attempt < 60; ++attempt, t0 *= 0.5)
+      if (std::fabs(second) > t0 * W.norm_eA2 * std::exp(W.norm_A * t0) * z0) return t0;
+    return std::nullopt;
+  }
   if (third == 0 || !std::isfinite(third)) return std::nullopt;
-  // w'''' = eA³ z with ‖z(t)‖ ≤ e^{‖A‖t} ‖z(0)‖.
-  const double z0 = (witness.A * x0 + witness.c).cwiseAbs().maxCoeff();
+  // w''' dominant (w'' = 0): |w'''(0)| > t0 sup|w''''|, sup|w''''| ≤ ‖eA³‖ e^{‖A‖t0} z0.
   double t0 = std::cbrt(6 * noise / std::fabs(third));
   for (int attempt = 0; attempt < 60; ++attempt, t0 *= 0.5)
     if (std::fabs(third) > t0 * W.norm_eA3 * std::exp(W.norm_A * t0) * z0) return t0;

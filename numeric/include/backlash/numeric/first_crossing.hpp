@@ -51,10 +51,11 @@ struct CrossingOptions {
   long max_intervals = 2'000'000; ///< guard: then std::runtime_error (never a hang)
 };
 
-/// For a witness that starts with w = w' = w'' = 0 at t = 0 (the gap on the
+/// For a witness that starts at zero, w(0) = w'(0) = 0 (a gap leaving a face:
+/// with w''(0) ≠ 0 after a bounce, or w''(0) = 0 and w'''(0) ≠ 0 on the
 /// separation line): a time t0 > 0 such that w is certified non-zero on
-/// (0, t0] (its third derivative keeps its sign there: |w'''(0)| > t0·sup|w''''|)
-/// and |w(t0)| ≈ noise; nothing when w'''(0) = 0.
+/// (0, t0] (its first non-vanishing derivative keeps its sign there) and
+/// |w(t0)| ≈ noise; nothing when both vanish.
 std::optional<double> certified_departure(const LinearWitness& witness, double noise);
 
 /// First t in (t_begin, t_end] with w(t) = 0, or nothing.

@@ -1,0 +1,10 @@
+# Hybrid dynamics on the validated evaluators: certified event location
+# (witness functions), dividing lines, the hybrid simulator, limit cycles.
+target_sources(backlash_numeric PRIVATE
+  ${CMAKE_CURRENT_LIST_DIR}/src/first_crossing.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/segment_dynamics.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/gap_events.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/linear_flight.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/dividing_lines.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/hybrid_simulation.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/limit_cycle.cpp)

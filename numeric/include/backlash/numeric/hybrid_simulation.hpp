@@ -1,0 +1,87 @@
+// backlash/numeric/hybrid_simulation.hpp — the hybrid automaton, event by event.
+//
+// One frame throughout (DESIGN.md §1): the gap x = θL − θm is centred, the
+// contact faces are x = ±b/2, and the measured shaft θo is continuous through
+// every event.  Modes and guards:
+//   contact on face σ (x = σ b/2)   θo from the validated closed form (eq. 25);
+//                                   holds while −σ·Tc ≥ 0, Tc = JL θ̈o + FL θ̇o;
+//   separation                      Tc leaves its holding sign (the state is then on the
+//                                   separation line θo = θR + cot φ θ̇o);
+//   free                            from the separation line: the validated closed form
+//                                   (t, θ̇m0); from any other state (after a bounce): the
+//                                   exact matrix exponential of the segment's linear ODE;
+//   recombination                   x reaches the opposite face −σ b/2;
+//   recontact                       x returns to the face σ b/2 it left;
+//   impact (eq. 24)                 inelastic: (Jm+JL) θ̇ = Jm θ̇m + JL θ̇L; contact on the
+//                                   face hit holds if the torque has its holding sign there,
+//                                   else the bodies part again at once (a bounce);
+//   rest                            free flight that can never close the gap again and whose
+//                                   velocities have decayed below `rest_velocity`.
+// Every event time is the first zero of a certified witness (first_crossing.hpp):
+// no fixed steps, nothing skipped.  Outcomes that are not errors come back as
+// statuses: completed (t_end reached), rest, chattering (Zeno: too many impacts in
+// a vanishing time), event_limit, non_finite — never a hang or a NaN.
+#pragma once
+
+#include "backlash/numeric/validation.hpp"
+
+#include <string>
+#include <vector>
+
+namespace backlash::numeric {
+
+enum class EventKind { Separation, Recombination, Recontact, Rest };
+const char* to_string(EventKind kind);
+
+struct HybridState {
+  double theta_m = 0, dtheta_m = 0, theta_L = 0, dtheta_L = 0;
+  bool in_contact = true;
+  int face = -1;  ///< σ: contact face x = σ b/2 (contact), or the face last left (free)
+};
+
+struct SimulationEvent {
+  double t = 0;
+  EventKind kind = EventKind::Separation;
+  double theta_o = 0, dtheta_o = 0;  ///< measured shaft, velocity after the event
+  HybridState after;
+  bool bounce = false;               ///< impact after which contact did not hold
+  bool grazing = false;
+};
+
+enum class SimulationStatus { Completed, Rest, Chattering, EventLimit, NonFinite };
+const char* to_string(SimulationStatus status);
+
+struct SimulationOptions {
+  double t_end = 60;
+  double sample_interval = 0;   ///< > 0: record the trajectory every sample_interval (for CSV)
+  long max_events = 100000;
+  double rest_velocity = 1e-9;  ///< rest when every velocity is below this (and no event can follow)
+  int zeno_impacts = 100;       ///< chattering when this many impacts happen within zeno_window
+  double zeno_window = 1e-6;
+  long stop_after_separations = 0;  ///< > 0: stop (status completed) right after this many separations
+};
+
+struct TrajectorySample {
+  double t, theta_o, dtheta_o, theta_m, dtheta_m, theta_L, dtheta_L;
+  bool in_contact;
+};
+
+struct SimulationResult {
+  SimulationStatus status = SimulationStatus::Completed;
+  std::vector<SimulationEvent> events;
+  double t_final = 0;
+  HybridState final_state;
+  double theta_o_final = 0;
+  std::vector<TrajectorySample> samples;
+};
+
+/// The measured shaft of a state.
+double measured(const Parameters& p, const HybridState& s);
+
+/// Start at rest, in contact on the face that drives toward θR, with θo = θR − step.
+HybridState step_start(const Parameters& p, double step);
+
+SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options);
+SimulationResult simulate_step(const ValidatedEvaluator& evaluator, double step, const SimulationOptions& options);
+
+}  // namespace backlash::numeric

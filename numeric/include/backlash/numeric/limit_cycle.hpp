@@ -1,0 +1,69 @@
+// backlash/numeric/limit_cycle.hpp — limit cycles from the return map on the
+// separation line.
+//
+// The system is odd-symmetric about (θR, 0) with the backlash faces swapped,
+// so a symmetric cycle is two mirror-image halves.  The half-cycle map
+//   g(v) = −θ̇o at the next separation,  starting from the separation point
+//          θo = θR + cot φ·v, θ̇o = v > 0 (free flight, impact, contact arc),
+// is computed with the exact hybrid simulator; a limit cycle is a fixed point
+// g(v*) = v*, bracketed on a logarithmic grid and refined with Boost.Math's
+// toms748.  The full return map is P = g∘g, so its multiplier is P'(v*) = g'(v*)²
+// (stable when < 1).  On the cycle: the amplitude max|θo − θR|, the peak-to-peak
+// swings of θo, θm and θL (one frame, DESIGN.md §1), the period and the
+// separation velocity v*, and eq. 38's C at separation and just after
+// recombination.  No fixed point (cases I, II: the backlash is outside the loop)
+// is the status "none", with the reason.
+#pragma once
+
+#include "backlash/numeric/hybrid_simulation.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace backlash::numeric {
+
+struct HalfCycle {
+  bool valid = false;      ///< reached a separation with the opposite velocity sign
+  std::string outcome;     ///< why not, when invalid ("rest", "same-face separation", …)
+  double v_in = 0, v_out = 0;  ///< v_out = g(v_in) = −θ̇o at the next separation
+  double duration = 0;
+  bool bounced = false;
+};
+
+/// One half cycle from the separation line with θ̇o = v > 0.
+HalfCycle half_cycle(const ValidatedEvaluator& evaluator, double v);
+
+/// Eq. 38: C(θo, θ̇o) for the contact mode (principal arctan; requires 4JK > F²).
+double stability_constant(const Parameters& p, double theta_o, double dtheta_o);
+/// exp(−π a/ω): the factor by which the principal-branch C jumps across θo = θR.
+double stability_constant_jump(const Parameters& p);
+
+struct LimitCycle {
+  std::string status = "none";  ///< "limit_cycle" | "none"
+  std::string reason;           ///< for "none"
+  double separation_velocity = 0;   ///< v*
+  double multiplier = 0;            ///< P'(v*) = g'(v*)² of the full return map
+  double half_map_derivative = 0;   ///< g'(v*)
+  bool stable = false;
+  double period = 0;
+  double amplitude = 0;             ///< max |θo − θR|
+  double peak_to_peak = 0;          ///< of θo
+  double peak_to_peak_motor = 0, peak_to_peak_load = 0;
+  double theta_o_max = 0, theta_o_min = 0;
+  // Eq. 38 on the cycle (principal branch): at separation, just after recombination.
+  double C_separation = 0, C_recombination = 0;
+  double theta_o_separation = 0, theta_o_recombination = 0, dtheta_o_recombination = 0;
+  int contact_arc_crossings_of_theta_R = 0;  ///< crossings of θo = θR between recombination and separation
+  bool bounced = false;
+  std::vector<double> other_fixed_points;     ///< further (e.g. unstable) cycles found
+};
+
+struct LimitCycleOptions {
+  double v_min = 1e-4, v_max = 10;  ///< search range of separation velocities (×max(1, |θR|))
+  int grid = 120;                   ///< logarithmic grid points
+};
+
+LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycleOptions& options = {});
+
+}  // namespace backlash::numeric

@@ -1,0 +1,25 @@
+// backlash/numeric/linear_flight.hpp — a linear segment x' = A x + c from any
+// initial state, in closed form: x(t) = e^{A t} x0 + ∫₀ᵗ e^{A s} ds c, from the
+// exponential of the augmented matrix [[A, c], [0, 0]] (Eigen's
+// MatrixFunctions: Padé approximation with scaling and squaring, accurate to a
+// few ulps).  Used for free flight that does not start on the separation line
+// (after a bounce), where the per-case evaluators (t, θ̇m0) do not apply; its
+// agreement with Boost.Odeint is tested like every evaluator's.
+#pragma once
+
+#include "backlash/numeric/segment_dynamics.hpp"
+
+namespace backlash::numeric {
+
+class LinearFlight {
+ public:
+  LinearFlight(LinearSegment segment, Eigen::VectorXd x0);
+  Eigen::VectorXd state(double t) const;
+  const LinearSegment& segment() const { return segment_; }
+
+ private:
+  LinearSegment segment_;
+  Eigen::VectorXd x0_;
+};
+
+}  // namespace backlash::numeric

@@ -1,0 +1,28 @@
+#include "gap_events.hpp"
+
+namespace backlash::numeric::detail {
+
+std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<Eigen::VectorXd(double)> state,
+                                        std::function<double(double)> gap_change, double opposite_face_change,
+                                        double horizon, double position_scale) {
+  LinearWitness w;
+  w.A = free_segment.A;
+  w.c = free_segment.c;
+  w.e = Eigen::RowVectorXd::Zero(4);
+  w.e(0) = -1;
+  w.e(2) = 1;
+  w.state = std::move(state);
+  w.value = std::move(gap_change);
+  w.level = opposite_face_change;
+  const std::optional<Crossing> opposite = first_crossing(w, 0, horizon);
+  // Return to the face left: Δx starts as O(t²) or O(t³), below rounding noise at first.
+  w.level = 0;
+  std::optional<Crossing> back;
+  if (const std::optional<double> t0 = certified_departure(w, 1e-10 * std::max(1.0, position_scale)))
+    back = first_crossing(w, *t0, opposite ? opposite->t : horizon);
+  if (back && (!opposite || back->t < opposite->t)) return GapEvent{GapEventKind::FaceLeft, *back};
+  if (opposite) return GapEvent{GapEventKind::OppositeFace, *opposite};
+  return std::nullopt;
+}
+
+}  // namespace backlash::numeric::detail

@@ -1,0 +1,300 @@
+#include "backlash/numeric/hybrid_simulation.hpp"
+
+#include "backlash/numeric/first_crossing.hpp"
+#include "backlash/numeric/linear_flight.hpp"
+#include "backlash/numeric/segment_dynamics.hpp"
+#include "gap_events.hpp"
+
+#include <boost/math/tools/roots.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <functional>
+
+namespace backlash::numeric {
+
+const char* to_string(EventKind kind) {
+  switch (kind) {
+    case EventKind::Separation: return "separation";
+    case EventKind::Recombination: return "recombination";
+    case EventKind::Recontact: return "recontact";
+    case EventKind::Rest: return "rest";
+  }
+  return "?";
+}
+
+const char* to_string(SimulationStatus status) {
+  switch (status) {
+    case SimulationStatus::Completed: return "completed";
+    case SimulationStatus::Rest: return "rest";
+    case SimulationStatus::Chattering: return "chattering";
+    case SimulationStatus::EventLimit: return "event_limit";
+    case SimulationStatus::NonFinite: return "non_finite";
+  }
+  return "?";
+}
+
+double measured(const Parameters& p, const HybridState& s) {
+  return p.measured_at == model::MeasuredAt::Motor ? s.theta_m : s.theta_L;
+}
+
+namespace {
+
+// A contact state on face σ with the measured shaft at θo: the other shaft sits at the face.
+HybridState contact_state_on_face(const Parameters& p, int face, double theta_o, double velocity) {
+  HybridState s;
+  s.in_contact = true;
+  s.face = face;
+  s.dtheta_m = s.dtheta_L = velocity;
+  const double x = face * p.backlash / 2;  // θL − θm
+  if (p.measured_at == model::MeasuredAt::Motor) {
+    s.theta_m = theta_o;
+    s.theta_L = theta_o + x;
+  } else {
+    s.theta_L = theta_o;
+    s.theta_m = theta_o - x;
+  }
+  return s;
+}
+
+bool finite(const HybridState& s) {
+  return std::isfinite(s.theta_m) && std::isfinite(s.theta_L) && std::isfinite(s.dtheta_m) && std::isfinite(s.dtheta_L);
+}
+
+// A free flight in the simulation frame: state(τ) and the gap change since its start.
+struct Flight {
+  std::function<HybridState(double)> at;
+  std::function<Eigen::VectorXd(double)> vector;
+  std::function<double(double)> gap_change;
+};
+
+Flight flight_from_separation_line(const ValidatedEvaluator& evaluator, const HybridState& start) {
+  const Parameters& p = evaluator.parameters();
+  const double v = start.dtheta_m;
+  const double theta0 = evaluator.evaluator().separation_theta(v);  // thesis frame: θm(0) = θL(0) = θ0
+  const double offset_m = start.theta_m - theta0, offset_L = start.theta_L - theta0;
+  (void)p;
+  Flight f;
+  f.at = [&evaluator, v, offset_m, offset_L, face = start.face](double tau) {
+    const FreeState s = evaluator.free_state(tau, v);
+    HybridState h;
+    h.in_contact = false;
+    h.face = face;
+    h.theta_m = s.theta_m + offset_m;
+    h.theta_L = s.theta_L + offset_L;
+    h.dtheta_m = s.dtheta_m;
+    h.dtheta_L = s.dtheta_L;
+    return h;
+  };
+  f.vector = [at = f.at](double tau) {
+    const HybridState h = at(tau);
+    Eigen::VectorXd x(4);
+    x << h.theta_m, h.dtheta_m, h.theta_L, h.dtheta_L;
+    return x;
+  };
+  f.gap_change = [&evaluator, v](double tau) { return evaluator.free_state(tau, v).gap; };
+  return f;
+}
+
+Flight flight_from_state(const Parameters& p, const HybridState& start) {
+  Eigen::VectorXd x0(4);
+  x0 << start.theta_m, start.dtheta_m, start.theta_L, start.dtheta_L;
+  auto flight = std::make_shared<LinearFlight>(free_mode_segment(p), x0);
+  const double gap0 = start.theta_L - start.theta_m;
+  Flight f;
+  f.vector = [flight](double tau) { return flight->state(tau); };
+  f.at = [flight, face = start.face](double tau) {
+    const Eigen::VectorXd x = flight->state(tau);
+    HybridState h;
+    h.in_contact = false;
+    h.face = face;
+    h.theta_m = x(0);
+    h.dtheta_m = x(1);
+    h.theta_L = x(2);
+    h.dtheta_L = x(3);
+    return h;
+  };
+  f.gap_change = [flight, gap0](double tau) {
+    const Eigen::VectorXd x = flight->state(tau);
+    return x(2) - x(0) - gap0;
+  };
+  return f;
+}
+
+bool on_separation_line(const ValidatedEvaluator& evaluator, double theta_o, double velocity) {
+  const double line = evaluator.evaluator().separation_theta(velocity);
+  return std::fabs(theta_o - line) <= 1e-9 * std::max({1.0, std::fabs(theta_o), std::fabs(velocity)});
+}
+
+class Recorder {
+ public:
+  Recorder(const Parameters& p, const SimulationOptions& o, SimulationResult& r) : p_(p), o_(o), r_(r) {}
+  // Samples of a segment on [t0, t1] (segment time τ = t − t0).
+  void segment(double t0, double t1, const std::function<HybridState(double)>& at) {
+    if (o_.sample_interval <= 0) return;
+    while (next_ <= t1 + 1e-12) {
+      const HybridState h = at(next_ - t0);
+      r_.samples.push_back({next_, measured(p_, h), p_.measured_at == model::MeasuredAt::Motor ? h.dtheta_m : h.dtheta_L,
+                            h.theta_m, h.dtheta_m, h.theta_L, h.dtheta_L, h.in_contact});
+      next_ += o_.sample_interval;
+    }
+  }
+
+ private:
+  const Parameters& p_;
+  const SimulationOptions& o_;
+  SimulationResult& r_;
+  double next_ = 0;
+};
+
+}  // namespace
+
+HybridState step_start(const Parameters& p, double step) {
+  // θo = θR − A, at rest, on the face that drives toward θR: for A > 0 the motor pushes
+  // forward (x = −b/2), for A < 0 backward (x = +b/2).
+  return contact_state_on_face(p, step >= 0 ? -1 : +1, p.theta_R - step, 0);
+}
+
+SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options) {
+  const Parameters& p = evaluator.parameters();
+  SimulationResult result;
+  Recorder recorder(p, options, result);
+  const LinearSegment contact_segment = contact_mode_segment(p);
+  const LinearSegment free_segment = free_mode_segment(p);
+  const TransmittedTorque torque = transmitted_torque(p);
+  HybridState state = start;
+  double t = 0;
+  std::deque<double> impacts;
+  long separations = 0;
+  auto finish = [&](SimulationStatus status) {
+    result.status = status;
+    result.t_final = t;
+    result.final_state = state;
+    result.theta_o_final = measured(p, state);
+    return result;
+  };
+  auto push_event = [&](EventKind kind, bool bounce, bool grazing) {
+    SimulationEvent e;
+    e.t = t;
+    e.kind = kind;
+    e.theta_o = measured(p, state);
+    e.dtheta_o = p.measured_at == model::MeasuredAt::Motor ? state.dtheta_m : state.dtheta_L;
+    e.after = state;
+    e.bounce = bounce;
+    e.grazing = grazing;
+    result.events.push_back(e);
+  };
+
+  while (t < options.t_end) {
+    if (!finite(state)) return finish(SimulationStatus::NonFinite);
+    if (static_cast<long>(result.events.size()) >= options.max_events) return finish(SimulationStatus::EventLimit);
+    const double remaining = options.t_end - t;
+
+    if (state.in_contact) {
+      const double theta0 = measured(p, state), omega0 = state.dtheta_m;
+      LinearWitness w;
+      w.A = contact_segment.A;
+      w.c = contact_segment.c;
+      w.e = torque.r;
+      w.level = -torque.r0;  // w = Tc
+      w.state = [&evaluator, theta0, omega0](double tau) {
+        const ContactState c = evaluator.contact_state(tau, theta0, omega0);
+        Eigen::VectorXd y(2);
+        y << c.theta_o, c.dtheta_o;
+        return y;
+      };
+      const int face = state.face;
+      auto at = [&evaluator, &p, theta0, omega0, face](double tau) {
+        const ContactState c = evaluator.contact_state(tau, theta0, omega0);
+        return contact_state_on_face(p, face, c.theta_o, c.dtheta_o);
+      };
+      // The next time Tc leaves its holding sign (a grazing touch keeps contact).
+      std::optional<Crossing> separation;
+      double from = 0;
+      if (std::fabs(transmitted_torque_at(p, theta0, omega0)) <= 1e-13 * std::max(1.0, std::fabs(omega0))) {
+        // Starting on the separation line: certified departure of Tc first.
+        if (auto t0 = certified_departure(w, 1e-12)) from = *t0;
+      }
+      while (true) {
+        separation = first_crossing(w, from, remaining);
+        if (!separation || !separation->grazing) break;
+        from = separation->t + 1e-12 * std::max(1.0, separation->t);
+      }
+      if (!separation) {
+        recorder.segment(t, options.t_end, at);
+        state = at(remaining);
+        t = options.t_end;
+        return finish(SimulationStatus::Completed);
+      }
+      recorder.segment(t, t + separation->t, at);
+      const HybridState at_separation = at(separation->t);
+      t += separation->t;
+      state = at_separation;
+      state.in_contact = false;  // face σ is the face just left
+      push_event(EventKind::Separation, false, false);
+      if (options.stop_after_separations > 0 && ++separations >= options.stop_after_separations)
+        return finish(SimulationStatus::Completed);
+      continue;
+    }
+
+    // Free flight.
+    const double theta_o = measured(p, state);
+    const bool from_line = std::fabs(state.dtheta_m - state.dtheta_L) <= 1e-12 * std::max(1.0, std::fabs(state.dtheta_m)) &&
+                           on_separation_line(evaluator, theta_o, state.dtheta_m);
+    const Flight flight = from_line ? flight_from_separation_line(evaluator, state) : flight_from_state(p, state);
+    const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(state.dtheta_m)});
+    const auto event =
+        detail::first_gap_event(free_segment, flight.vector, flight.gap_change, -state.face * p.backlash, remaining, scale);
+    if (!event) {
+      recorder.segment(t, options.t_end, flight.at);
+      const HybridState end = flight.at(remaining);
+      const double speed = std::max(std::fabs(end.dtheta_m), std::fabs(end.dtheta_L));
+      if (speed < options.rest_velocity) {
+        // Rest: the last time any velocity exceeded the tolerance (bisection on the closed form).
+        double lo = 0, hi = remaining;
+        for (int i = 0; i < 200 && hi - lo > 1e-12 * std::max(1.0, hi); ++i) {
+          const double mid = 0.5 * (lo + hi);
+          bool moving = false;
+          for (int k = 0; k <= 32 && !moving; ++k) {  // any motion left in [mid, remaining]?
+            const HybridState s = flight.at(mid + (remaining - mid) * k / 32.0);
+            moving = std::max(std::fabs(s.dtheta_m), std::fabs(s.dtheta_L)) >= options.rest_velocity;
+          }
+          (moving ? lo : hi) = mid;
+        }
+        const double t_end = t + remaining;
+        t += hi;
+        state = flight.at(hi);
+        push_event(EventKind::Rest, false, false);
+        t = t_end;
+        state = end;
+        return finish(SimulationStatus::Rest);
+      }
+      state = end;
+      t = options.t_end;
+      return finish(SimulationStatus::Completed);
+    }
+    recorder.segment(t, t + event->crossing.t, flight.at);
+    HybridState before = flight.at(event->crossing.t);
+    t += event->crossing.t;
+    // Inelastic impact (eq. 24) on the face hit.
+    const int face_hit = event->kind == detail::GapEventKind::OppositeFace ? -state.face : state.face;
+    const double omega = recombined_velocity(p, before.dtheta_m, before.dtheta_L);
+    state = contact_state_on_face(p, face_hit, measured(p, before), omega);
+    const double tc = transmitted_torque_at(p, measured(p, state), omega);
+    const bool holds = -face_hit * tc >= -1e-14 * std::max(1.0, std::fabs(tc));
+    if (!holds) state.in_contact = false;  // a bounce: the bodies part again at once
+    push_event(event->kind == detail::GapEventKind::OppositeFace ? EventKind::Recombination : EventKind::Recontact, !holds,
+               event->crossing.grazing);
+    impacts.push_back(t);
+    while (!impacts.empty() && impacts.front() < t - options.zeno_window) impacts.pop_front();
+    if (static_cast<int>(impacts.size()) >= options.zeno_impacts) return finish(SimulationStatus::Chattering);
+  }
+  return finish(SimulationStatus::Completed);
+}
+
+SimulationResult simulate_step(const ValidatedEvaluator& evaluator, double step, const SimulationOptions& options) {
+  return simulate(evaluator, step_start(evaluator.parameters(), step), options);
+}
+
+}  // namespace backlash::numeric
