@@ -1,0 +1,67 @@
+// backlash/cli/numeric_case.hpp — a case's evaluator through the validation gate.
+//
+// trace, simulate and limit-cycle work only on an evaluator that passed the
+// gate (numeric/validation.hpp); if it did not, the command stops with a
+// one-line error naming the failing states (exit 1) and writes nothing.
+#pragma once
+
+#include "commands.hpp"
+
+#include "backlash/model/case_spec.hpp"
+#include "backlash/numeric/validation.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace backlash::cli {
+
+struct ValidatedCase {
+  model::CaseSpec spec;
+  numeric::ValidationResult validation;
+  const numeric::ValidatedEvaluator& evaluator() const { return validation.evaluator(); }
+};
+
+inline ValidatedCase validated_case(const std::string& case_name) {
+  model::CaseSpec spec = model::load_case(case_name);
+  numeric::ValidationResult result = numeric::validate(numeric::case_evaluator(spec));
+  if (!result.passed()) {
+    std::string failing;
+    for (const numeric::StateError& s : result.report().states)
+      if (!s.passed) failing += (failing.empty() ? "" : ", ") + s.state;
+    throw std::runtime_error("case " + spec.id + ": the evaluator failed validation against odeint (" + failing +
+                             "); refusing to use it");
+  }
+  return ValidatedCase{std::move(spec), std::move(result)};
+}
+
+/// A finite number, or UsageError naming the flag.
+inline double parse_number(const std::string& text, const std::string& flag) {
+  std::size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(text, &used);
+  } catch (...) {
+    throw UsageError(flag + ": '" + text + "' is not a number");
+  }
+  if (used != text.size()) throw UsageError(flag + ": '" + text + "' is not a number");
+  if (!std::isfinite(value)) throw UsageError(flag + ": '" + text + "' is not finite");
+  return value;
+}
+
+/// A comma-separated list of numbers; empty entries are errors.
+inline std::vector<double> parse_number_list(const std::string& text, const std::string& flag) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    const auto first = item.find_first_not_of(" \t"), last = item.find_last_not_of(" \t");
+    if (first == std::string::npos) throw UsageError(flag + ": empty entry in '" + text + "'");
+    values.push_back(parse_number(item.substr(first, last - first + 1), flag));
+  }
+  if (values.empty() || text.back() == ',') throw UsageError(flag + ": empty entry in '" + text + "'");
+  return values;
+}
+
+}  // namespace backlash::cli
