@@ -127,6 +127,42 @@ bool on_separation_line(const ValidatedEvaluator& evaluator, double theta_o, dou
   return std::fabs(theta_o - line) <= 1e-9 * std::max({1.0, std::fabs(theta_o), std::fabs(velocity)});
 }
 
+void include_state(const Parameters& p, const HybridState& h, Extremes& x) {
+  const double o = measured(p, h);
+  x.theta_o_min = std::min(x.theta_o_min, o);
+  x.theta_o_max = std::max(x.theta_o_max, o);
+  x.theta_m_min = std::min(x.theta_m_min, h.theta_m);
+  x.theta_m_max = std::max(x.theta_m_max, h.theta_m);
+  x.theta_L_min = std::min(x.theta_L_min, h.theta_L);
+  x.theta_L_max = std::max(x.theta_L_max, h.theta_L);
+}
+
+// Extremes of a segment on [0, duration]: its end states and the certified zeros of θ̇m and θ̇L
+// (in contact both are θ̇o).  `vector(τ)` is the segment's state x, x' = A x + c.
+void segment_extremes(const Parameters& p, const LinearSegment& segment, const std::function<Eigen::VectorXd(double)>& vector,
+                      const std::function<HybridState(double)>& at, double duration, bool contact, Extremes& x) {
+  include_state(p, at(0), x);
+  include_state(p, at(duration), x);
+  const Eigen::Index n = segment.A.rows();
+  std::vector<Eigen::Index> velocity_rows = contact ? std::vector<Eigen::Index>{1} : std::vector<Eigen::Index>{1, 3};
+  for (Eigen::Index row : velocity_rows) {
+    LinearWitness w;
+    w.A = segment.A;
+    w.c = segment.c;
+    w.e = Eigen::RowVectorXd::Zero(n);
+    w.e(row) = 1;
+    w.state = vector;
+    double from = 0;
+    for (int k = 0; k < 10000; ++k) {
+      const auto zero = first_crossing(w, from, duration);
+      if (!zero) break;
+      include_state(p, at(zero->t), x);
+      from = zero->t + 1e-12 * std::max(1.0, zero->t);
+      if (from >= duration) break;
+    }
+  }
+}
+
 class Recorder {
  public:
   Recorder(const Parameters& p, const SimulationOptions& o, SimulationResult& r) : p_(p), o_(o), r_(r) {}
@@ -221,6 +257,14 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
         if (!separation || !separation->grazing) break;
         from = separation->t + 1e-12 * std::max(1.0, separation->t);
       }
+      auto contact_vector = [&evaluator, theta0, omega0](double tau) {
+        const ContactState c = evaluator.contact_state(tau, theta0, omega0);
+        Eigen::VectorXd y(2);
+        y << c.theta_o, c.dtheta_o;
+        return y;
+      };
+      if (options.track_extremes)
+        segment_extremes(p, contact_segment, contact_vector, at, separation ? separation->t : remaining, true, result.extremes);
       if (!separation) {
         recorder.segment(t, options.t_end, at);
         state = at(remaining);
@@ -246,6 +290,8 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
     const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(state.dtheta_m)});
     const auto event =
         detail::first_gap_event(free_segment, flight.vector, flight.gap_change, -state.face * p.backlash, remaining, scale);
+    if (options.track_extremes)
+      segment_extremes(p, free_segment, flight.vector, flight.at, event ? event->crossing.t : remaining, false, result.extremes);
     if (!event) {
       recorder.segment(t, options.t_end, flight.at);
       const HybridState end = flight.at(remaining);

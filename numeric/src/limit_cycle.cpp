@@ -1,8 +1,8 @@
 #include "backlash/numeric/limit_cycle.hpp"
 
+#include "backlash/numeric/first_crossing.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
 
-#include <boost/math/tools/minima.hpp>
 #include <boost/math/tools/roots.hpp>
 
 #include <algorithm>
@@ -36,7 +36,7 @@ double horizon(const Parameters& p) { return std::max(100.0, 60 * slowest_time_s
 
 }  // namespace
 
-HalfCycle half_cycle(const ValidatedEvaluator& evaluator, double v) {
+HalfCycle half_cycle(const ValidatedEvaluator& evaluator, double v, bool track_extremes) {
   const Parameters& p = evaluator.parameters();
   HalfCycle h;
   h.v_in = v;
@@ -44,8 +44,10 @@ HalfCycle half_cycle(const ValidatedEvaluator& evaluator, double v) {
   options.t_end = horizon(p);
   options.stop_after_separations = 1;
   options.max_events = 1000;
-  const SimulationResult r = simulate(evaluator, separation_state(evaluator, v), options);
+  options.track_extremes = track_extremes;
+  SimulationResult r = simulate(evaluator, separation_state(evaluator, v), options);
   for (const SimulationEvent& e : r.events) h.bounced = h.bounced || e.bounce;
+  h.extremes = r.extremes;
   if (r.events.empty() || r.events.back().kind != EventKind::Separation) {
     h.outcome = r.status == SimulationStatus::Rest ? "rest: no recombination"
                                                    : std::string("no separation within the horizon (") + to_string(r.status) + ")";
@@ -59,6 +61,7 @@ HalfCycle half_cycle(const ValidatedEvaluator& evaluator, double v) {
   h.valid = true;
   h.v_out = -s.dtheta_o;
   h.duration = s.t;
+  h.events = std::move(r.events);
   return h;
 }
 
@@ -76,6 +79,34 @@ double stability_constant_jump(const Parameters& p) {
   return std::exp(-M_PI * a / std::sqrt(p.K / J - a * a));
 }
 
+namespace {
+
+// h(v) = g(v) − v, NaN where the half cycle does not return to the line.
+double excess(const ValidatedEvaluator& evaluator, double v) {
+  const HalfCycle hc = half_cycle(evaluator, v);
+  return hc.valid ? hc.v_out - v : std::nan("");
+}
+
+bool converged(double a, double b) { return std::fabs(b - a) <= 1e-13 * std::max(1.0, std::fabs(b)); }
+
+// Secant steps from a guess (sweeps: the neighbour's cycle); nothing if they wander off.
+std::optional<double> secant_fixed_point(const ValidatedEvaluator& evaluator, double guess) {
+  double v0 = guess, v1 = guess * 1.01;
+  double h0 = excess(evaluator, v0), h1 = excess(evaluator, v1);
+  for (int i = 0; i < 30; ++i) {
+    if (std::isnan(h0) || std::isnan(h1) || h1 == h0) return std::nullopt;
+    const double v2 = v1 - h1 * (v1 - v0) / (h1 - h0);
+    if (!(v2 > 0) || v2 > 4 * guess || v2 < guess / 4) return std::nullopt;
+    if (converged(v1, v2)) return v2;
+    v0 = v1; h0 = h1;
+    v1 = v2; h1 = excess(evaluator, v1);
+    if (h1 == 0) return v1;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycleOptions& options) {
   const Parameters& p = evaluator.parameters();
   LimitCycle cycle;
@@ -83,47 +114,47 @@ LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycl
     cycle.reason = "no backlash";
     return cycle;
   }
-  const double scale = std::max(1.0, std::fabs(p.theta_R));
-  // h(v) = g(v) − v on a logarithmic grid; brackets where it changes sign between valid points.
-  std::vector<std::pair<double, double>> samples;
-  std::string last_failure;
-  for (int i = 0; i < options.grid; ++i) {
-    const double v = scale * options.v_min * std::pow(options.v_max / options.v_min, i / double(options.grid - 1));
-    const HalfCycle hc = half_cycle(evaluator, v);
-    if (hc.valid) samples.push_back({v, hc.v_out - v}); else { samples.push_back({v, std::nan("")}); last_failure = hc.outcome; }
-  }
-  auto g_minus_v = [&](double v) {
-    const HalfCycle hc = half_cycle(evaluator, v);
-    return hc.valid ? hc.v_out - v : std::nan("");
-  };
   std::vector<double> roots;
-  for (size_t i = 1; i < samples.size(); ++i) {
-    const auto [v0, h0] = samples[i - 1];
-    const auto [v1, h1] = samples[i];
-    if (std::isnan(h0) || std::isnan(h1) || (h0 > 0) == (h1 > 0)) continue;
-    boost::uintmax_t iterations = 100;
-    const auto r = boost::math::tools::toms748_solve(
-        g_minus_v, v0, v1, h0, h1, [](double a, double b) { return std::fabs(b - a) <= 1e-13 * std::max(1.0, b); },
-        iterations);
-    roots.push_back(0.5 * (r.first + r.second));
+  if (options.guess > 0)
+    if (auto v = secant_fixed_point(evaluator, options.guess)) roots.push_back(*v);
+  std::string last_failure;
+  bool any_valid = !roots.empty();
+  if (roots.empty()) {
+    // h(v) = g(v) − v on a logarithmic grid; brackets where it changes sign between valid points.
+    const double scale = std::max(1.0, std::fabs(p.theta_R));
+    std::vector<std::pair<double, double>> samples;
+    for (int i = 0; i < options.grid; ++i) {
+      const double v = scale * options.v_min * std::pow(options.v_max / options.v_min, i / double(options.grid - 1));
+      const HalfCycle hc = half_cycle(evaluator, v);
+      samples.push_back({v, hc.valid ? hc.v_out - v : std::nan("")});
+      if (!hc.valid) last_failure = hc.outcome;
+      any_valid = any_valid || hc.valid;
+    }
+    for (size_t i = 1; i < samples.size(); ++i) {
+      const auto [v0, h0] = samples[i - 1];
+      const auto [v1, h1] = samples[i];
+      if (std::isnan(h0) || std::isnan(h1) || (h0 > 0) == (h1 > 0)) continue;
+      boost::uintmax_t iterations = 100;
+      const auto r = boost::math::tools::toms748_solve([&](double v) { return excess(evaluator, v); }, v0, v1, h0, h1,
+                                                       [](double a, double b) { return converged(a, b); }, iterations);
+      roots.push_back(0.5 * (r.first + r.second));
+    }
   }
   if (roots.empty()) {
-    bool any_valid = false;
-    for (const auto& s : samples) any_valid = any_valid || !std::isnan(s.second);
     cycle.reason = any_valid ? "the half-cycle map has no fixed point: every separation velocity decays (g(v) < v)"
                              : "no half cycle returns to the separation line (" + last_failure + ")";
     if (p.measured_at == model::MeasuredAt::Motor)
       cycle.reason += "; the backlash is outside the loop, so the system settles with a steady-state error";
     return cycle;
   }
-  // The stable cycle (|g'| < 1), else the first.
+  // g'(v) by central differences (g is smooth away from grazing); the stable cycle (|g'| < 1) is "the" cycle.
   auto derivative = [&](double v) {
     const double h = 1e-6 * v;
-    const HalfCycle a = half_cycle(evaluator, v - h), b = half_cycle(evaluator, v + h);
-    return (b.v_out - a.v_out) / (2 * h);
+    return (half_cycle(evaluator, v + h).v_out - half_cycle(evaluator, v - h).v_out) / (2 * h);
   };
   double chosen = roots.front(), chosen_derivative = derivative(chosen);
   for (double r : roots) {
+    if (r == chosen) continue;
     const double d = derivative(r);
     if (std::fabs(d) < 1 && !(std::fabs(chosen_derivative) < 1)) { chosen = r; chosen_derivative = d; }
   }
@@ -134,73 +165,50 @@ LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycl
   cycle.multiplier = chosen_derivative * chosen_derivative;
   cycle.stable = cycle.multiplier < 1;
 
-  // One full period (two mirrored halves), sampled densely for the swings; extrema refined by Brent.
-  SimulationOptions options_cycle;
-  options_cycle.t_end = horizon(p);
-  options_cycle.stop_after_separations = 2;
-  const HybridState start = separation_state(evaluator, chosen);
-  const SimulationResult full = simulate(evaluator, start, options_cycle);
-  cycle.period = full.t_final;
-  for (const SimulationEvent& e : full.events) cycle.bounced = cycle.bounced || e.bounce;
-  SimulationOptions sampled = options_cycle;
-  sampled.sample_interval = cycle.period / 20000;
-  const SimulationResult trajectory = simulate(evaluator, start, sampled);
-  double o_max = -INFINITY, o_min = INFINITY, m_max = -INFINITY, m_min = INFINITY, l_max = -INFINITY, l_min = INFINITY;
-  for (const TrajectorySample& s : trajectory.samples) {
-    o_max = std::max(o_max, s.theta_o); o_min = std::min(o_min, s.theta_o);
-    m_max = std::max(m_max, s.theta_m); m_min = std::min(m_min, s.theta_m);
-    l_max = std::max(l_max, s.theta_L); l_min = std::min(l_min, s.theta_L);
-  }
-  // Refine the measured shaft's extremes: by symmetry the cycle is odd about θR.
-  auto theta_o_at = [&](double t) {
-    SimulationOptions o = options_cycle;
-    o.t_end = t;
-    o.stop_after_separations = 0;
-    return simulate(evaluator, start, o).theta_o_final;
-  };
-  const double dt = sampled.sample_interval;
-  auto refine = [&](double sign, double best) {
-    double t_best = 0;
-    for (const TrajectorySample& s : trajectory.samples) if (s.theta_o * sign >= best * sign) t_best = s.t;
-    const auto r = boost::math::tools::brent_find_minima([&](double t) { return -sign * theta_o_at(t); },
-                                                         std::max(1e-12, t_best - dt), t_best + dt, 50);
-    return std::max(best * sign, -r.second) * sign;
-  };
-  o_max = refine(+1, o_max);
-  o_min = refine(-1, o_min);
-  // Extremes at a kink (an impact reverses θ̇o) are event states, exact.
-  for (const SimulationEvent& e : full.events) {
-    o_max = std::max(o_max, e.theta_o);
-    o_min = std::min(o_min, e.theta_o);
-  }
-  cycle.theta_o_max = o_max;
-  cycle.theta_o_min = o_min;
-  cycle.amplitude = std::max(std::fabs(o_max - p.theta_R), std::fabs(o_min - p.theta_R));
-  cycle.peak_to_peak = o_max - o_min;
-  cycle.peak_to_peak_motor = m_max - m_min;
-  cycle.peak_to_peak_load = l_max - l_min;
+  // The half cycle at v*, with its exact extremes; the other half is its mirror image about θR.
+  const HalfCycle half = half_cycle(evaluator, chosen, true);
+  cycle.period = 2 * half.duration;
+  cycle.bounced = half.bounced;
+  const Extremes& x = half.extremes;
+  const double R2 = 2 * p.theta_R;
+  auto full_max = [&](double lo, double hi) { return std::max(hi, R2 - lo); };
+  auto full_min = [&](double lo, double hi) { return std::min(lo, R2 - hi); };
+  cycle.theta_o_max = full_max(x.theta_o_min, x.theta_o_max);
+  cycle.theta_o_min = full_min(x.theta_o_min, x.theta_o_max);
+  cycle.amplitude = std::max(cycle.theta_o_max - p.theta_R, p.theta_R - cycle.theta_o_min);
+  cycle.peak_to_peak = cycle.theta_o_max - cycle.theta_o_min;
+  cycle.peak_to_peak_motor = full_max(x.theta_m_min, x.theta_m_max) - full_min(x.theta_m_min, x.theta_m_max);
+  cycle.peak_to_peak_load = full_max(x.theta_L_min, x.theta_L_max) - full_min(x.theta_L_min, x.theta_L_max);
 
-  // Eq. 38 at separation and just after the (first) recombination of the cycle.
+  // Eq. 38 at separation and just after the recombination of this half cycle, and whether the
+  // contact arc between them crosses θo = θR (where the principal branch of C jumps).
   cycle.theta_o_separation = evaluator.evaluator().separation_theta(chosen);
   cycle.C_separation = stability_constant(p, cycle.theta_o_separation, chosen);
-  for (const SimulationEvent& e : full.events) {
+  for (size_t i = 0; i < half.events.size(); ++i) {
+    const SimulationEvent& e = half.events[i];
     if (e.kind != EventKind::Recombination) continue;
     cycle.theta_o_recombination = e.theta_o;
     cycle.dtheta_o_recombination = e.dtheta_o;
     cycle.C_recombination = stability_constant(p, e.theta_o, e.dtheta_o);
-    // The contact arc from here to the next separation: does it cross θo = θR?
-    const SimulationEvent* next = nullptr;
-    for (const SimulationEvent& f : full.events) if (f.t > e.t && f.kind == EventKind::Separation) { next = &f; break; }
-    if (next) {
-      int crossings = 0;
-      double previous = e.theta_o - p.theta_R;
-      for (const TrajectorySample& s : trajectory.samples) {
-        if (s.t <= e.t || s.t >= next->t) continue;
-        const double now = s.theta_o - p.theta_R;
-        if ((now > 0) != (previous > 0)) ++crossings;
-        previous = now;
-      }
-      cycle.contact_arc_crossings_of_theta_R = crossings;
+    const double arc = half.events.back().t - e.t;
+    const LinearSegment contact = contact_mode_segment(p);
+    LinearWitness w;
+    w.A = contact.A;
+    w.c = contact.c;
+    w.e = Eigen::RowVectorXd::Zero(2);
+    w.e(0) = 1;
+    w.level = p.theta_R;
+    w.state = [&evaluator, e](double tau) {
+      const ContactState c = evaluator.contact_state(tau, e.theta_o, e.dtheta_o);
+      Eigen::VectorXd y(2);
+      y << c.theta_o, c.dtheta_o;
+      return y;
+    };
+    double from = 0;
+    while (const auto crossing = first_crossing(w, from, arc)) {
+      if (!crossing->grazing) ++cycle.contact_arc_crossings_of_theta_R;
+      from = crossing->t + 1e-12 * std::max(1.0, crossing->t);
+      if (from >= arc) break;
     }
     break;
   }

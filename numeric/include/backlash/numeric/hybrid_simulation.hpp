@@ -25,6 +25,7 @@
 
 #include "backlash/numeric/validation.hpp"
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,15 @@ struct SimulationOptions {
   int zeno_impacts = 100;       ///< chattering when this many impacts happen within zeno_window
   double zeno_window = 1e-6;
   long stop_after_separations = 0;  ///< > 0: stop (status completed) right after this many separations
+  bool track_extremes = false;      ///< record the exact extremes of θo, θm, θL (zeros of the velocities)
+};
+
+/// Exact extremes over the simulated time: at event states and at the certified
+/// zeros of each shaft's velocity inside every segment.
+struct Extremes {
+  double theta_o_min = INFINITY, theta_o_max = -INFINITY;
+  double theta_m_min = INFINITY, theta_m_max = -INFINITY;
+  double theta_L_min = INFINITY, theta_L_max = -INFINITY;
 };
 
 struct TrajectorySample {
@@ -73,6 +83,7 @@ struct SimulationResult {
   HybridState final_state;
   double theta_o_final = 0;
   std::vector<TrajectorySample> samples;
+  Extremes extremes;  ///< when options.track_extremes
 };
 
 /// The measured shaft of a state.

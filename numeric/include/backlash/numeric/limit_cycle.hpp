@@ -25,6 +25,8 @@ namespace backlash::numeric {
 
 struct HalfCycle {
   bool valid = false;      ///< reached a separation with the opposite velocity sign
+  Extremes extremes;       ///< exact extremes over the half cycle (when requested)
+  std::vector<SimulationEvent> events;
   std::string outcome;     ///< why not, when invalid ("rest", "same-face separation", …)
   double v_in = 0, v_out = 0;  ///< v_out = g(v_in) = −θ̇o at the next separation
   double duration = 0;
@@ -32,7 +34,7 @@ struct HalfCycle {
 };
 
 /// One half cycle from the separation line with θ̇o = v > 0.
-HalfCycle half_cycle(const ValidatedEvaluator& evaluator, double v);
+HalfCycle half_cycle(const ValidatedEvaluator& evaluator, double v, bool track_extremes = false);
 
 /// Eq. 38: C(θo, θ̇o) for the contact mode (principal arctan; requires 4JK > F²).
 double stability_constant(const Parameters& p, double theta_o, double dtheta_o);
@@ -61,7 +63,9 @@ struct LimitCycle {
 
 struct LimitCycleOptions {
   double v_min = 1e-4, v_max = 10;  ///< search range of separation velocities (×max(1, |θR|))
-  int grid = 120;                   ///< logarithmic grid points
+  int grid = 40;                    ///< logarithmic grid points for the bracketing search
+  double guess = 0;                 ///< > 0: start with secant steps from this v (continuation in sweeps),
+                                    ///< falling back to the bracketing search if they do not converge
 };
 
 LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycleOptions& options = {});
