@@ -11,6 +11,7 @@
 #include <cmath>
 #include <deque>
 #include <functional>
+#include <limits>
 
 namespace backlash::numeric {
 
@@ -256,6 +257,17 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
         separation = first_crossing(w, from, remaining);
         if (!separation || !separation->grazing) break;
         from = separation->t + 1e-12 * std::max(1.0, separation->t);
+      }
+      // Tc = r·y + r0 goes through the cancellation θR − θo: once the contact motion has decayed
+      // to rounding level its sign is noise, and a "separation" found there is spurious (e.g. an
+      // over-damped contact whose Tc = A e^{λ1 t} + B e^{λ2 t} has no zero for t > 0).  The test is
+      // on the state, not on Tc's terms: when Fm/Jm = FL/JL the velocity term of Tc vanishes
+      // identically and every genuine separation happens at θo = θR, with θ̇o far from zero.
+      if (separation) {
+        const ContactState c = evaluator.contact_state(separation->t, theta0, omega0);
+        const double noise = 1024 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(p.theta_R));
+        const double rate = std::sqrt(p.K / (p.Jm + p.JL));  // converts a velocity to a displacement scale
+        if (std::fabs(c.theta_o - p.theta_R) <= noise && std::fabs(c.dtheta_o) <= noise * rate) separation.reset();
       }
       auto contact_vector = [&evaluator, theta0, omega0](double tau) {
         const ContactState c = evaluator.contact_state(tau, theta0, omega0);

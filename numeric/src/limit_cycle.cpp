@@ -205,7 +205,9 @@ LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycl
       return y;
     };
     double from = 0;
-    while (const auto crossing = first_crossing(w, from, arc)) {
+    // Crossings strictly inside the arc (when cot φ = 0 the separation itself is at θo = θR).
+    const double end = arc * (1 - 1e-9);
+    while (const auto crossing = first_crossing(w, from, end)) {
       if (!crossing->grazing) ++cycle.contact_arc_crossings_of_theta_R;
       from = crossing->t + 1e-12 * std::max(1.0, crossing->t);
       if (from >= arc) break;

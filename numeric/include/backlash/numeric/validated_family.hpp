@@ -1,0 +1,50 @@
+// backlash/numeric/validated_family.hpp — the validation gate for parameter sweeps.
+//
+// A sweep evaluates the stable parametric layer at up to 10⁵ parameter points;
+// running the full odeint gate at each (≈ 2.5 ms) would dominate.  The
+// parametric layer is one code path per pole-structure branch, so a sweep
+// validates it as a family: at sample points of the sweep (its ends, every
+// k-th point, and the first point of each branch it enters, on demand) and at
+// the branch's representative.  An evaluator is handed out only for
+// parameters whose contact and free branches both passed at some sample of
+// this family; a point in a branch not yet covered is validated itself first.
+// A failed sample poisons its branch: points there are refused (never used
+// unvalidated).
+#pragma once
+
+#include "backlash/numeric/validation.hpp"
+
+#include <map>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace backlash::numeric {
+
+class ValidatedParametricFamily {
+ public:
+  explicit ValidatedParametricFamily(ValidationOptions options = {}) : options_(std::move(options)) {}
+
+  /// Validate the parametric evaluator at `samples` (thread-safe).  False if any failed.
+  bool validate_samples(const std::vector<Parameters>& samples);
+
+  /// A validated evaluator for `p`, validating `p` itself when its branches are not covered
+  /// yet; nothing when a sample of its branch failed validation (thread-safe).
+  std::optional<ValidatedEvaluator> at(const Parameters& p);
+
+  long samples_validated() const;
+  long samples_failed() const;
+  std::vector<std::string> covered_branches() const;
+
+ private:
+  bool validate_one(const Parameters& p);
+  ValidationOptions options_;
+  mutable std::mutex mutex_;
+  std::map<Branch, ValidationReport> passed_;
+  std::set<Branch> failed_;
+  long validated_ = 0, failed_count_ = 0;
+};
+
+}  // namespace backlash::numeric
