@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 namespace backlash::cli {
 
@@ -18,15 +19,16 @@ namespace {
 
 struct TraceOptions {
   std::string case_name;
-  std::string v0_list;
+  std::optional<std::string> v0_list;
   bool json = false;
 };
 
 nlohmann::json maybe(bool present, double value) { return present ? nlohmann::json(value) : nlohmann::json(nullptr); }
 
 void run_trace(const TraceOptions& options) {
+  if (options.v0_list && options.v0_list->empty()) throw UsageError("--v0: empty list");
   const std::vector<double> grid =
-      options.v0_list.empty() ? numeric::default_dividing_line_grid() : parse_number_list(options.v0_list, "--v0");
+      options.v0_list ? parse_number_list(*options.v0_list, "--v0") : numeric::default_dividing_line_grid();
   const ValidatedCase c = validated_case(options.case_name);
   const numeric::DividingLines lines = numeric::trace_dividing_lines(c.evaluator(), grid);
   if (options.json) {
