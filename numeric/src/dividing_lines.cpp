@@ -31,13 +31,13 @@ LinearWitness gap_witness(const ValidatedEvaluator& evaluator, double dtheta_m0,
   LinearWitness w;
   w.A = s.A;
   w.c = s.c;
-  w.e = Eigen::RowVectorXd::Zero(4);
+  w.e = SmallRow::Zero(4);
   w.e(0) = -1;
   w.e(2) = 1;
   w.level = level;
   w.state = [&evaluator, dtheta_m0](double t) {
     const FreeState f = evaluator.free_state(t, dtheta_m0);
-    Eigen::VectorXd x(4);
+    SmallVector x(4);
     x << f.theta_m, f.dtheta_m, f.theta_L, f.dtheta_L;
     return x;
   };
@@ -98,7 +98,7 @@ std::optional<double> recombination_threshold(const ValidatedEvaluator& evaluato
   LinearWitness slope;
   slope.A = s.A;
   slope.c = s.c;
-  slope.e = Eigen::RowVectorXd::Zero(4);
+  slope.e = SmallRow::Zero(4);
   slope.e(1) = -1;
   slope.e(3) = 1;
   slope.state = gap_witness(evaluator, unit, 0).state;

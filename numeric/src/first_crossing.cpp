@@ -16,7 +16,7 @@ struct Sample {
 
 struct Witness {
   const LinearWitness& lw;
-  Eigen::RowVectorXd eA, eA2, eA3;
+  SmallRow eA, eA2, eA3;
   double eAc, eA2c, norm_A, norm_c, norm_eA2, norm_eA3;
 
   explicit Witness(const LinearWitness& w) : lw(w) {
@@ -32,11 +32,11 @@ struct Witness {
   }
 
   Sample at(double t) const {
-    const Eigen::VectorXd x = lw.state(t);
+    const SmallVector x = lw.state(t);
     const double w = (lw.value ? lw.value(t) : lw.e.dot(x)) - lw.level;
     const double w1 = eA.dot(x) + lw.e.dot(lw.c);
     const double w2 = eA2.dot(x) + eAc;
-    const Eigen::VectorXd z = lw.A * x + lw.c;  // x' obeys z' = A z
+    const SmallVector z = lw.A * x + lw.c;  // x' obeys z' = A z
     return {t, w, w1, w2, z.cwiseAbs().maxCoeff()};
   }
 
@@ -50,7 +50,7 @@ bool same_sign(double x, double y) { return (x > 0 && y > 0) || (x < 0 && y < 0)
 
 std::optional<double> certified_departure(const LinearWitness& witness, double noise) {
   const Witness W(witness);
-  const Eigen::VectorXd x0 = witness.state(0);
+  const SmallVector x0 = witness.state(0);
   const double z0 = (witness.A * x0 + witness.c).cwiseAbs().maxCoeff();  // ‖x'(0)‖, with ‖x'(t)‖ ≤ e^{‖A‖t} z0
   const double second = W.eA.dot(witness.A * x0 + witness.c);           // w''(0) = eA x'(0)
   const double third = W.eA2.dot(witness.A * x0 + witness.c);           // w'''(0) = eA² x'(0)

@@ -2,13 +2,13 @@
 
 namespace backlash::numeric::detail {
 
-std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<Eigen::VectorXd(double)> state,
+std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
                                         std::function<double(double)> gap_change, double opposite_face_change,
                                         double horizon, double position_scale) {
   LinearWitness w;
   w.A = free_segment.A;
   w.c = free_segment.c;
-  w.e = Eigen::RowVectorXd::Zero(4);
+  w.e = SmallRow::Zero(4);
   w.e(0) = -1;
   w.e(2) = 1;
   w.state = std::move(state);

@@ -21,7 +21,7 @@ struct GapEvent {
 /// relative velocity.  `state` gives x(t) = (θm, θ̇m, θL, θ̇L) (any frame),
 /// `gap_change` gives Δx(t) directly.  The first time Δx reaches
 /// `opposite_face_change` (±b) or returns to 0 (certified departure first).
-std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<Eigen::VectorXd(double)> state,
+std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
                                         std::function<double(double)> gap_change, double opposite_face_change,
                                         double horizon, double position_scale);
 

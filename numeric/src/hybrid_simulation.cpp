@@ -66,7 +66,7 @@ bool finite(const HybridState& s) {
 // A free flight in the simulation frame: state(τ) and the gap change since its start.
 struct Flight {
   std::function<HybridState(double)> at;
-  std::function<Eigen::VectorXd(double)> vector;
+  std::function<SmallVector(double)> vector;
   std::function<double(double)> gap_change;
 };
 
@@ -90,7 +90,7 @@ Flight flight_from_separation_line(const ValidatedEvaluator& evaluator, const Hy
   };
   f.vector = [at = f.at](double tau) {
     const HybridState h = at(tau);
-    Eigen::VectorXd x(4);
+    SmallVector x(4);
     x << h.theta_m, h.dtheta_m, h.theta_L, h.dtheta_L;
     return x;
   };
@@ -99,14 +99,14 @@ Flight flight_from_separation_line(const ValidatedEvaluator& evaluator, const Hy
 }
 
 Flight flight_from_state(const Parameters& p, const HybridState& start) {
-  Eigen::VectorXd x0(4);
+  SmallVector x0(4);
   x0 << start.theta_m, start.dtheta_m, start.theta_L, start.dtheta_L;
   auto flight = std::make_shared<LinearFlight>(free_mode_segment(p), x0);
   const double gap0 = start.theta_L - start.theta_m;
   Flight f;
   f.vector = [flight](double tau) { return flight->state(tau); };
   f.at = [flight, face = start.face](double tau) {
-    const Eigen::VectorXd x = flight->state(tau);
+    const SmallVector x = flight->state(tau);
     HybridState h;
     h.in_contact = false;
     h.face = face;
@@ -117,7 +117,7 @@ Flight flight_from_state(const Parameters& p, const HybridState& start) {
     return h;
   };
   f.gap_change = [flight, gap0](double tau) {
-    const Eigen::VectorXd x = flight->state(tau);
+    const SmallVector x = flight->state(tau);
     return x(2) - x(0) - gap0;
   };
   return f;
@@ -140,7 +140,7 @@ void include_state(const Parameters& p, const HybridState& h, Extremes& x) {
 
 // Extremes of a segment on [0, duration]: its end states and the certified zeros of θ̇m and θ̇L
 // (in contact both are θ̇o).  `vector(τ)` is the segment's state x, x' = A x + c.
-void segment_extremes(const Parameters& p, const LinearSegment& segment, const std::function<Eigen::VectorXd(double)>& vector,
+void segment_extremes(const Parameters& p, const LinearSegment& segment, const std::function<SmallVector(double)>& vector,
                       const std::function<HybridState(double)>& at, double duration, bool contact, Extremes& x) {
   include_state(p, at(0), x);
   include_state(p, at(duration), x);
@@ -150,7 +150,7 @@ void segment_extremes(const Parameters& p, const LinearSegment& segment, const s
     LinearWitness w;
     w.A = segment.A;
     w.c = segment.c;
-    w.e = Eigen::RowVectorXd::Zero(n);
+    w.e = SmallRow::Zero(n);
     w.e(row) = 1;
     w.state = vector;
     double from = 0;
@@ -237,7 +237,7 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
       w.level = -torque.r0;  // w = Tc
       w.state = [&evaluator, theta0, omega0](double tau) {
         const ContactState c = evaluator.contact_state(tau, theta0, omega0);
-        Eigen::VectorXd y(2);
+        SmallVector y(2);
         y << c.theta_o, c.dtheta_o;
         return y;
       };
@@ -271,7 +271,7 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
       }
       auto contact_vector = [&evaluator, theta0, omega0](double tau) {
         const ContactState c = evaluator.contact_state(tau, theta0, omega0);
-        Eigen::VectorXd y(2);
+        SmallVector y(2);
         y << c.theta_o, c.dtheta_o;
         return y;
       };

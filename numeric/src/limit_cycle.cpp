@@ -90,17 +90,24 @@ double excess(const ValidatedEvaluator& evaluator, double v) {
 bool converged(double a, double b) { return std::fabs(b - a) <= 1e-13 * std::max(1.0, std::fabs(b)); }
 
 // Secant steps from a guess (sweeps: the neighbour's cycle); nothing if they wander off.
-std::optional<double> secant_fixed_point(const ValidatedEvaluator& evaluator, double guess) {
-  double v0 = guess, v1 = guess * 1.01;
+// Also returns h'(v*) from the last secant pair whose spacing is well above the noise
+// of h (|Δv| ≥ 1e-7 v): accurate to about five digits, enough for the multiplier in sweeps.
+struct SecantResult {
+  double v, slope;
+};
+std::optional<SecantResult> secant_fixed_point(const ValidatedEvaluator& evaluator, double guess) {
+  double v0 = guess, v1 = guess * 1.001;
   double h0 = excess(evaluator, v0), h1 = excess(evaluator, v1);
+  double slope = std::nan("");
   for (int i = 0; i < 30; ++i) {
     if (std::isnan(h0) || std::isnan(h1) || h1 == h0) return std::nullopt;
+    if (std::fabs(v1 - v0) >= 1e-7 * std::fabs(v1)) slope = (h1 - h0) / (v1 - v0);
     const double v2 = v1 - h1 * (v1 - v0) / (h1 - h0);
     if (!(v2 > 0) || v2 > 4 * guess || v2 < guess / 4) return std::nullopt;
-    if (converged(v1, v2)) return v2;
+    if (converged(v1, v2)) return SecantResult{v2, slope};
     v0 = v1; h0 = h1;
     v1 = v2; h1 = excess(evaluator, v1);
-    if (h1 == 0) return v1;
+    if (h1 == 0) return SecantResult{v1, slope};
   }
   return std::nullopt;
 }
@@ -115,8 +122,12 @@ LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycl
     return cycle;
   }
   std::vector<double> roots;
+  double secant_slope = std::nan("");
   if (options.guess > 0)
-    if (auto v = secant_fixed_point(evaluator, options.guess)) roots.push_back(*v);
+    if (auto r = secant_fixed_point(evaluator, options.guess)) {
+      roots.push_back(r->v);
+      secant_slope = r->slope;
+    }
   std::string last_failure;
   bool any_valid = !roots.empty();
   if (roots.empty()) {
@@ -152,7 +163,8 @@ LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycl
     const double h = 1e-6 * v;
     return (half_cycle(evaluator, v + h).v_out - half_cycle(evaluator, v - h).v_out) / (2 * h);
   };
-  double chosen = roots.front(), chosen_derivative = derivative(chosen);
+  double chosen = roots.front();
+  double chosen_derivative = std::isnan(secant_slope) ? derivative(chosen) : secant_slope + 1;  // g' = h' + 1
   for (double r : roots) {
     if (r == chosen) continue;
     const double d = derivative(r);
@@ -195,12 +207,12 @@ LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycl
     LinearWitness w;
     w.A = contact.A;
     w.c = contact.c;
-    w.e = Eigen::RowVectorXd::Zero(2);
+    w.e = SmallRow::Zero(2);
     w.e(0) = 1;
     w.level = p.theta_R;
     w.state = [&evaluator, e](double tau) {
       const ContactState c = evaluator.contact_state(tau, e.theta_o, e.dtheta_o);
-      Eigen::VectorXd y(2);
+      SmallVector y(2);
       y << c.theta_o, c.dtheta_o;
       return y;
     };

@@ -6,7 +6,7 @@
 namespace backlash::numeric {
 
 LinearSegment free_mode_segment(const Parameters& p) {
-  LinearSegment s{Eigen::MatrixXd::Zero(4, 4), Eigen::VectorXd::Zero(4)};
+  LinearSegment s{SmallMatrix::Zero(4, 4), SmallVector::Zero(4)};
   s.A(0, 1) = 1;
   s.A(1, 1) = -p.Fm / p.Jm;
   if (p.measured_at == model::MeasuredAt::Motor) s.A(1, 0) = -p.K / p.Jm; else s.A(1, 2) = -p.K / p.Jm;
@@ -18,7 +18,7 @@ LinearSegment free_mode_segment(const Parameters& p) {
 
 LinearSegment contact_mode_segment(const Parameters& p) {
   const double J = p.Jm + p.JL, F = p.Fm + p.FL;
-  LinearSegment s{Eigen::MatrixXd::Zero(2, 2), Eigen::VectorXd::Zero(2)};
+  LinearSegment s{SmallMatrix::Zero(2, 2), SmallVector::Zero(2)};
   s.A(0, 1) = 1;
   s.A(1, 0) = -p.K / J;
   s.A(1, 1) = -F / J;
@@ -29,7 +29,7 @@ LinearSegment contact_mode_segment(const Parameters& p) {
 TransmittedTorque transmitted_torque(const Parameters& p) {
   // Tc = JL (K(θR − θ) − F θ̇)/J + FL θ̇
   const double J = p.Jm + p.JL, F = p.Fm + p.FL;
-  TransmittedTorque t{Eigen::RowVectorXd(2), p.JL * p.K * p.theta_R / J};
+  TransmittedTorque t{SmallRow(2), p.JL * p.K * p.theta_R / J};
   t.r(0) = -p.JL * p.K / J;
   t.r(1) = -p.JL * F / J + p.FL;
   return t;

@@ -61,9 +61,9 @@ std::vector<SweepRow> run_sweep(const std::vector<SweepPoint>& points, const Swe
   ValidatedParametricFamily family;
   {
     std::vector<Parameters> samples;
-    const long stride = std::max(1, options.validation_stride);
-    for (size_t i = 0; i < points.size(); i += stride) samples.push_back(points[i].parameters);
-    if (!points.empty()) samples.push_back(points.back().parameters);
+    const size_t count = std::min<size_t>(points.size(), std::max(2, options.validation_samples));
+    for (size_t k = 0; k < count; ++k)
+      samples.push_back(points[count == 1 ? 0 : k * (points.size() - 1) / (count - 1)].parameters);
     family.validate_samples(samples);
   }
   std::atomic<long> done{0};

@@ -27,13 +27,19 @@
 
 namespace backlash::numeric {
 
+/// Small fixed-capacity Eigen types (at most the free mode's 4 states): no heap allocation
+/// in the witness searches, which evaluate states hundreds of times per event.
+using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 4, 4>;
+using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 4, 1>;
+using SmallRow = Eigen::Matrix<double, 1, Eigen::Dynamic, Eigen::RowMajor, 1, 4>;
+
 /// w(t) = eᵀx(t) − level for a linear segment x' = A x + c with exact x(t).
 struct LinearWitness {
-  Eigen::MatrixXd A;
-  Eigen::VectorXd c;
-  Eigen::RowVectorXd e;
+  SmallMatrix A;
+  SmallVector c;
+  SmallRow e;
   double level = 0;
-  std::function<Eigen::VectorXd(double)> state;  ///< exact x(t) (a validated closed form)
+  std::function<SmallVector(double)> state;  ///< exact x(t) (a validated closed form)
   /// Optional: w(t) + level computed directly by the closed form (e.g. the gap,
   /// free of the cancellation in θL − θm); otherwise eᵀx(t).
   std::function<double(double)> value;

@@ -13,13 +13,13 @@ namespace backlash::numeric {
 
 class LinearFlight {
  public:
-  LinearFlight(LinearSegment segment, Eigen::VectorXd x0);
-  Eigen::VectorXd state(double t) const;
+  LinearFlight(LinearSegment segment, SmallVector x0);
+  SmallVector state(double t) const;
   const LinearSegment& segment() const { return segment_; }
 
  private:
   LinearSegment segment_;
-  Eigen::VectorXd x0_;
+  SmallVector x0_;
 };
 
 }  // namespace backlash::numeric

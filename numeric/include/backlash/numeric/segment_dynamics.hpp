@@ -11,6 +11,7 @@
 // on the face x = −b/2 holds while Tc ≥ 0, on x = +b/2 while Tc ≤ 0.
 #pragma once
 
+#include "backlash/numeric/first_crossing.hpp"
 #include "backlash/numeric/parametric.hpp"
 
 #include <Eigen/Dense>
@@ -18,8 +19,8 @@
 namespace backlash::numeric {
 
 struct LinearSegment {
-  Eigen::MatrixXd A;
-  Eigen::VectorXd c;
+  SmallMatrix A;
+  SmallVector c;
 };
 
 LinearSegment free_mode_segment(const Parameters& p);
@@ -27,7 +28,7 @@ LinearSegment contact_mode_segment(const Parameters& p);
 
 /// Tc as a row vector on (θo, θ̇o) plus constant: Tc = r·y + r0.
 struct TransmittedTorque {
-  Eigen::RowVectorXd r;
+  SmallRow r;
   double r0;
 };
 TransmittedTorque transmitted_torque(const Parameters& p);

@@ -8,7 +8,9 @@
 //   b = .3, θR = 1, output at the load; figure 31 uses F = .4 (cases V–VIII).
 // Points run on `threads` threads, each over a contiguous run of points so
 // each limit-cycle search starts from its neighbour's cycle (continuation);
-// every evaluator comes from a ValidatedParametricFamily (validated_family.hpp).
+// every evaluator comes from a ValidatedParametricFamily (validated_family.hpp),
+// validated at `validation_samples` evenly spaced points and at the first point of
+// every further branch the sweep enters.
 // A point's failure is a status in its row, never an exception.
 #pragma once
 
@@ -35,7 +37,7 @@ struct SweepRow {
 
 struct SweepOptions {
   int threads = 2;
-  int validation_stride = 50;  ///< validate the parametric family at every k-th point (and the ends)
+  int validation_samples = 64;  ///< validate the parametric family at this many evenly spaced points (ends included)
   std::function<void(long done, long total)> progress;  ///< called from worker threads (serialised)
 };
 
