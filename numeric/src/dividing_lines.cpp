@@ -27,22 +27,15 @@ double horizon_of(const Parameters& p, const TraceOptions& options) {
 }
 
 LinearWitness gap_witness(const ValidatedEvaluator& evaluator, double dtheta_m0, double level) {
-  const LinearSegment s = free_mode_segment(evaluator.parameters());
-  LinearWitness w;
-  w.A = s.A;
-  w.c = s.c;
-  w.e = SmallRow::Zero(4);
-  w.e(0) = -1;
-  w.e(2) = 1;
-  w.level = level;
-  w.state = [&evaluator, dtheta_m0](double t) {
-    const FreeState f = evaluator.free_state(t, dtheta_m0);
-    SmallVector x(4);
-    x << f.theta_m, f.dtheta_m, f.theta_L, f.dtheta_L;
-    return x;
-  };
-  w.value = [&evaluator, dtheta_m0](double t) { return evaluator.free_state(t, dtheta_m0).gap; };
-  return w;
+  return detail::gap_change_witness(
+      free_mode_segment(evaluator.parameters()),
+      [&evaluator, dtheta_m0](double t) {
+        const FreeState f = evaluator.free_state(t, dtheta_m0);
+        SmallVector x(4);
+        x << f.theta_m, f.dtheta_m, f.theta_L, f.dtheta_L;
+        return x;
+      },
+      [&evaluator, dtheta_m0](double t) { return evaluator.free_state(t, dtheta_m0).gap; }, level);
 }
 
 // Start of the search for a return to the face left.  On the separation line

@@ -2,9 +2,8 @@
 
 namespace backlash::numeric::detail {
 
-std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
-                                        std::function<double(double)> gap_change, double opposite_face_change,
-                                        double horizon, double position_scale) {
+LinearWitness gap_change_witness(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
+                                 std::function<double(double)> gap_change, double level) {
   LinearWitness w;
   w.A = free_segment.A;
   w.c = free_segment.c;
@@ -13,7 +12,14 @@ std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::
   w.e(2) = 1;
   w.state = std::move(state);
   w.value = std::move(gap_change);
-  w.level = opposite_face_change;
+  w.level = level;
+  return w;
+}
+
+std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
+                                        std::function<double(double)> gap_change, double opposite_face_change,
+                                        double horizon, double position_scale) {
+  LinearWitness w = gap_change_witness(free_segment, std::move(state), std::move(gap_change), opposite_face_change);
   const std::optional<Crossing> opposite = first_crossing(w, 0, horizon);
   // Return to the face left: Δx starts as O(t²) or O(t³), below rounding noise at first.
   w.level = 0;

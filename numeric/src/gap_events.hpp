@@ -17,6 +17,10 @@ struct GapEvent {
   Crossing crossing;
 };
 
+/// The witness of the gap change Δx = θL − θm − Δx(0) − level of a free flight.
+LinearWitness gap_change_witness(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
+                                 std::function<double(double)> gap_change, double level);
+
 /// A free flight whose gap change Δx(t) = x(t) − x(0) starts at 0 with zero
 /// relative velocity.  `state` gives x(t) = (θm, θ̇m, θL, θ̇L) (any frame),
 /// `gap_change` gives Δx(t) directly.  The first time Δx reaches

@@ -42,21 +42,8 @@ double measured(const Parameters& p, const HybridState& s) {
 
 namespace {
 
-// A contact state on face σ with the measured shaft at θo: the other shaft sits at the face.
 HybridState contact_state_on_face(const Parameters& p, int face, double theta_o, double velocity) {
-  HybridState s;
-  s.in_contact = true;
-  s.face = face;
-  s.dtheta_m = s.dtheta_L = velocity;
-  const double x = face * p.backlash / 2;  // θL − θm
-  if (p.measured_at == model::MeasuredAt::Motor) {
-    s.theta_m = theta_o;
-    s.theta_L = theta_o + x;
-  } else {
-    s.theta_L = theta_o;
-    s.theta_m = theta_o - x;
-  }
-  return s;
+  return state_on_face(p, face, theta_o, velocity, true);
 }
 
 bool finite(const HybridState& s) {
@@ -186,6 +173,22 @@ class Recorder {
 };
 
 }  // namespace
+
+HybridState state_on_face(const Parameters& p, int face, double theta_o, double velocity, bool in_contact) {
+  HybridState s;
+  s.in_contact = in_contact;
+  s.face = face;
+  s.dtheta_m = s.dtheta_L = velocity;
+  const double x = face * p.backlash / 2;  // θL − θm
+  if (p.measured_at == model::MeasuredAt::Motor) {
+    s.theta_m = theta_o;
+    s.theta_L = theta_o + x;
+  } else {
+    s.theta_L = theta_o;
+    s.theta_m = theta_o - x;
+  }
+  return s;
+}
 
 HybridState step_start(const Parameters& p, double step) {
   // θo = θR − A, at rest, on the face that drives toward θR: for A > 0 the motor pushes

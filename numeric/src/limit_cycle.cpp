@@ -14,22 +14,7 @@ namespace {
 
 // The separation state on the line with θ̇o = v, having left face σ = −sign(v).
 HybridState separation_state(const ValidatedEvaluator& evaluator, double v) {
-  const Parameters& p = evaluator.parameters();
-  const int face = v > 0 ? -1 : +1;
-  HybridState s;
-  s.in_contact = false;
-  s.face = face;
-  s.dtheta_m = s.dtheta_L = v;
-  const double theta_o = evaluator.evaluator().separation_theta(v);
-  const double x = face * p.backlash / 2;
-  if (p.measured_at == model::MeasuredAt::Motor) {
-    s.theta_m = theta_o;
-    s.theta_L = theta_o + x;
-  } else {
-    s.theta_L = theta_o;
-    s.theta_m = theta_o - x;
-  }
-  return s;
+  return state_on_face(evaluator.parameters(), v > 0 ? -1 : +1, evaluator.evaluator().separation_theta(v), v, false);
 }
 
 double horizon(const Parameters& p) { return std::max(100.0, 60 * slowest_time_scale(p)); }

@@ -17,13 +17,7 @@ namespace {
 using namespace backlash;
 using backlash::testing::PrintedCell;
 
-const numeric::ValidatedEvaluator& validated(const std::string& case_id) {
-  static std::map<std::string, numeric::ValidationResult> cache;
-  auto found = cache.find(case_id);
-  if (found == cache.end())
-    found = cache.emplace(case_id, numeric::validate(numeric::case_evaluator(model::load_case(case_id)))).first;
-  return found->second.evaluator();
-}
+const numeric::ValidatedEvaluator& validated(const std::string& case_id) { return backlash::testing::validated_thesis_case(case_id); }
 
 double quantity_of(const numeric::DividingLinePoint& p, const std::string& quantity) {
   if (quantity == "t" || quantity == "t (load part)") return p.t;

@@ -15,13 +15,7 @@ namespace {
 
 using namespace backlash;
 
-const numeric::ValidatedEvaluator& validated(const std::string& case_id) {
-  static std::map<std::string, numeric::ValidationResult> cache;
-  auto found = cache.find(case_id);
-  if (found == cache.end())
-    found = cache.emplace(case_id, numeric::validate(numeric::case_evaluator(model::load_case(case_id)))).first;
-  return found->second.evaluator();
-}
+const numeric::ValidatedEvaluator& validated(const std::string& case_id) { return backlash::testing::validated_thesis_case(case_id); }
 
 const numeric::LimitCycle& cycle(const std::string& id) {
   static std::map<std::string, numeric::LimitCycle> cache;

@@ -38,6 +38,14 @@ int decimals_of(const std::string& printed) {
 
 }  // namespace
 
+const numeric::ValidatedEvaluator& validated_thesis_case(const std::string& case_id) {
+  static std::map<std::string, numeric::ValidationResult> cache;
+  auto found = cache.find(case_id);
+  if (found == cache.end())
+    found = cache.emplace(case_id, numeric::validate(numeric::case_evaluator(model::load_case(case_id)))).first;
+  return found->second.evaluator();
+}
+
 double printed_number(const std::string& text) { return std::stod(text[0] == '.' || (text[0] == '-' && text[1] == '.') ? (text[0] == '-' ? "-0" + text.substr(1) : "0" + text) : text); }
 
 std::vector<PrintedCell> printed_cells(const std::string& table) {

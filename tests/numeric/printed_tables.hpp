@@ -10,10 +10,15 @@
 // printed text) with `exact_decimal` equal to the computed value within 1e-8.
 #pragma once
 
+#include "backlash/numeric/validation.hpp"
+
 #include <string>
 #include <vector>
 
 namespace backlash::testing {
+
+/// A thesis case's generated evaluator through the validation gate (cached per test process).
+const numeric::ValidatedEvaluator& validated_thesis_case(const std::string& case_id);
 
 struct PrintedCell {
   std::string table, case_id, v0, quantity, printed;

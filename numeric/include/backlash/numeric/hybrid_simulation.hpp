@@ -89,6 +89,10 @@ struct SimulationResult {
 /// The measured shaft of a state.
 double measured(const Parameters& p, const HybridState& s);
 
+/// The state with the measured shaft at θo, both shafts moving at `velocity`, and the
+/// gap at the face σ (x = σ b/2): in contact on it, or just leaving it.
+HybridState state_on_face(const Parameters& p, int face, double theta_o, double velocity, bool in_contact);
+
 /// Start at rest, in contact on the face that drives toward θR, with θo = θR − step.
 HybridState step_start(const Parameters& p, double step);
 
