@@ -21,5 +21,11 @@ class UsageError : public std::runtime_error {
 
 void register_derive_command(CLI::App& app);   // cli/derive_command.cpp
 void register_report_command(CLI::App& app);   // cli/report_command.cpp
+void register_codegen_command(CLI::App& app);  // cli/codegen_command.cpp
+void register_validate_command(CLI::App& app); // cli/validate_command.cpp
+void register_trace_command(CLI::App& app);    // cli/trace_command.cpp
+void register_simulate_command(CLI::App& app); // cli/simulate_command.cpp
+void register_limit_cycle_command(CLI::App& app);  // cli/limit_cycle_command.cpp
+void register_sweep_command(CLI::App& app);    // cli/sweep_command.cpp
 
 }  // namespace backlash::cli

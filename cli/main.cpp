@@ -43,6 +43,10 @@ int main(int argument_count, char** arguments) {
   backlash::cli::register_report_command(app);
   backlash::cli::register_codegen_command(app);
   backlash::cli::register_validate_command(app);
+  backlash::cli::register_trace_command(app);
+  backlash::cli::register_simulate_command(app);
+  backlash::cli::register_limit_cycle_command(app);
+  backlash::cli::register_sweep_command(app);
 
   try {
     app.parse(argument_count, arguments);

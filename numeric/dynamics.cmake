@@ -7,4 +7,9 @@ target_sources(backlash_numeric PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/src/linear_flight.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/dividing_lines.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/hybrid_simulation.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/src/limit_cycle.cpp)
+  ${CMAKE_CURRENT_LIST_DIR}/src/limit_cycle.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/validated_family.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/sweep.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/odeint_simulation.cpp)   # odeint: the independent cross-check simulator
+find_package(Threads REQUIRED)
+target_link_libraries(backlash_numeric PUBLIC Threads::Threads)

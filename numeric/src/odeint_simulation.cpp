@@ -1,0 +1,484 @@
+// The independent hybrid simulator on Boost.Odeint (see odeint_simulation.hpp).
+// The only translation unit of the simulator that includes odeint (slow to compile).
+#include "backlash/numeric/odeint_simulation.hpp"
+
+#include <boost/math/tools/roots.hpp>
+#include <boost/numeric/odeint.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <deque>
+#include <exception>
+#include <limits>
+#include <optional>
+
+namespace backlash::numeric {
+
+namespace odeint = boost::numeric::odeint;
+
+namespace {
+
+using FreeVector = std::array<double, 4>;     // p = θm − θm0, θ̇m, S·Δ, S·Δ̇ (Δ = gap change since the start)
+using ContactVector = std::array<double, 2>;  // e = θo − θR, θ̇o
+
+// The mode ODEs, written out here from DESIGN.md §1 (independently of segment_dynamics).
+//
+// Free mode in start-relative coordinates: the motor's displacement p = θm − θm0 and the gap
+// change Δ = (θL − θm) − (θL0 − θm0), scaled by S.  The gap is then integrated directly (no
+// cancellation θL − θm) and its error is controlled at tolerance/S absolute: a gap that
+// leaves a face by 1e-13 and comes back (a bounce whose torque barely fails to hold) is
+// resolved, where integrating θm and θL separately at 1e-12 could not tell it from noise.
+//   θ̈m = (K(θR − θo) − Fm θ̇m)/Jm   (eq. 16, θo = θm; eq. 39, θo = θL)
+//   θ̈L = −FL θ̇L / JL                (eq. 17)
+struct FreeSystem {
+  Parameters p;
+  double e0;     ///< θo0 − θR at the start
+  double scale;  ///< S
+  bool at_motor;
+  double motor_acceleration(const FreeVector& y) const {
+    const double e = at_motor ? e0 + y[0] : e0 + y[0] + y[2] / scale;  // θo − θR
+    return (-p.K * e - p.Fm * y[1]) / p.Jm;
+  }
+  void operator()(const FreeVector& y, FreeVector& dy, double /*t*/) const {
+    const double am = motor_acceleration(y);
+    const double aL = -p.FL * (y[1] + y[3] / scale) / p.JL;
+    dy[0] = y[1];
+    dy[1] = am;
+    dy[2] = y[3];
+    dy[3] = scale * (aL - am);
+  }
+  /// The gap's second and third derivatives at a state: how it leaves the face.
+  std::pair<double, double> gap_departure(const FreeVector& y) const {
+    const double am = motor_acceleration(y), vL = y[1] + y[3] / scale, aL = -p.FL * vL / p.JL;
+    const double eo_rate = at_motor ? y[1] : vL;
+    const double jm = (-p.K * eo_rate - p.Fm * am) / p.Jm;
+    const double jL = -p.FL * aL / p.JL;
+    return {aL - am, jL - jm};
+  }
+};
+
+// Contact mode in the deviation e = θo − θR: then Tc is free of the cancellation θR − θo
+// and keeps its relative accuracy as the motion decays (its sign near equilibrium is not
+// rounding noise).
+struct ContactSystem {
+  Parameters p;
+  void operator()(const ContactVector& y, ContactVector& dy, double /*t*/) const {
+    dy[0] = y[1];
+    dy[1] = (-p.K * y[0] - (p.Fm + p.FL) * y[1]) / (p.Jm + p.JL);  // eq. 25
+  }
+};
+
+// Tc = JL·θ̈o + FL·θ̇o in contact, from the deviation e = θo − θR.
+double contact_torque_deviation(const Parameters& p, double e, double omega) {
+  const double acceleration = (-p.K * e - (p.Fm + p.FL) * omega) / (p.Jm + p.JL);
+  return p.JL * acceleration + p.FL * omega;
+}
+// Tc from θo (the impact's holding test, as the closed-form simulator writes it).
+double contact_torque(const Parameters& p, double theta_o, double omega) {
+  const double acceleration = (p.K * (p.theta_R - theta_o) - (p.Fm + p.FL) * omega) / (p.Jm + p.JL);
+  return p.JL * acceleration + p.FL * omega;
+}
+// dTc/dt in contact.
+double contact_torque_rate(const Parameters& p, double e, double omega) {
+  const double J = p.Jm + p.JL, F = p.Fm + p.FL;
+  const double acceleration = (-p.K * e - F * omega) / J;
+  const double jerk = (-p.K * omega - F * acceleration) / J;
+  return p.JL * jerk + p.FL * acceleration;
+}
+
+// The rule both simulators share (hybrid_simulation.cpp): a zero of Tc where the contact
+// motion has decayed to rounding level, |θo − θR| ≤ ν and |θ̇o| ≤ ν·√(K/J) with
+// ν = 1024 ε·max(1, |θR|), is not a separation (the closed form cannot resolve the sign of
+// Tc there: θR − θo cancels).  Contact then holds to t_end.
+bool at_rounding_level(const Parameters& p, const std::array<double, 2>& deviation) {
+  const double noise = 1024 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(p.theta_R));
+  const double rate = std::sqrt(p.K / (p.Jm + p.JL));
+  return std::fabs(deviation[0]) <= noise && std::fabs(deviation[1]) <= noise * rate;
+}
+
+HybridState contact_on_face(const Parameters& p, int face, double theta_o, double velocity) {
+  HybridState s;
+  s.in_contact = true;
+  s.face = face;
+  s.dtheta_m = s.dtheta_L = velocity;
+  const double x = face * p.backlash / 2;  // θL − θm
+  if (p.measured_at == model::MeasuredAt::Motor) {
+    s.theta_m = theta_o;
+    s.theta_L = theta_o + x;
+  } else {
+    s.theta_L = theta_o;
+    s.theta_m = theta_o - x;
+  }
+  return s;
+}
+
+// The free state from the start-relative coordinates.
+struct FreeFrame {
+  double theta_m0, theta_L0, scale;
+  int face;
+  HybridState at(const FreeVector& y) const {
+    HybridState h;
+    h.in_contact = false;
+    h.face = face;
+    h.theta_m = theta_m0 + y[0];
+    h.dtheta_m = y[1];
+    h.theta_L = theta_L0 + y[0] + y[2] / scale;
+    h.dtheta_L = y[1] + y[3] / scale;
+    return h;
+  }
+};
+
+bool finite(const HybridState& s) {
+  return std::isfinite(s.theta_m) && std::isfinite(s.theta_L) && std::isfinite(s.dtheta_m) && std::isfinite(s.dtheta_L);
+}
+
+template <class V>
+bool finite(const V& v) {
+  return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
+}
+
+struct NonFiniteState {};
+
+// Root of f on [a, b] (f(a), f(b) of opposite signs or one zero) with toms748.
+template <class F>
+double refine_root(F f, double a, double b, double fa, double fb) {
+  if (fa == 0) return a;
+  if (fb == 0) return b;
+  std::uintmax_t iterations = 200;
+  const auto bracket =
+      boost::math::tools::toms748_solve(f, a, b, fa, fb, boost::math::tools::eps_tolerance<double>(52), iterations);
+  return 0.5 * (bracket.first + bracket.second);
+}
+
+// One segment integrated with dopri5 + dense output from τ = 0 over [0, horizon].
+// `visit(t_old, t_new, stepper)` is called for each accepted step (t_new clamped to
+// the horizon) and returns true to stop.
+template <class Vector, class System, class Visit>
+void march(const System& system, const Vector& x0, double horizon, double dt_max, double tolerance, Visit visit,
+           double first_step = 0) {
+  auto stepper = odeint::make_dense_output(tolerance, tolerance, dt_max, odeint::runge_kutta_dopri5<Vector>());
+  double dt0 = std::min(dt_max, horizon) * 0.05;
+  if (first_step > 0) dt0 = std::min(dt0, first_step);
+  stepper.initialize(x0, 0.0, dt0);
+  double t_old = 0;
+  while (t_old < horizon) {
+    const auto step = stepper.do_step(system);
+    if (!finite(stepper.current_state()) || !std::isfinite(step.second)) throw NonFiniteState{};
+    const double t_new = std::min(step.second, horizon);
+    if (visit(t_old, t_new, stepper)) return;
+    t_old = t_new;
+  }
+}
+
+// Interior sample times of a step: t_old + (t_new − t_old)·k/n, k = 1..n (the last is t_new).
+inline double sample_time(double t_old, double t_new, int k, int n) {
+  return k == n ? t_new : t_old + (t_new - t_old) * k / n;
+}
+
+class Recorder {
+ public:
+  Recorder(const Parameters& p, const SimulationOptions& o, SimulationResult& r) : p_(p), o_(o), r_(r) {}
+  // Samples at global times ≤ t_upto on a segment starting at t0 (segment time τ = t − t0).
+  template <class At>
+  void upto(double t0, double t_upto, const At& at) {
+    if (o_.sample_interval <= 0) return;
+    while (next_ <= t_upto) {
+      const HybridState h = at(next_ - t0);
+      r_.samples.push_back({next_, measured(p_, h), p_.measured_at == model::MeasuredAt::Motor ? h.dtheta_m : h.dtheta_L,
+                            h.theta_m, h.dtheta_m, h.theta_L, h.dtheta_L, h.in_contact});
+      next_ += o_.sample_interval;
+    }
+  }
+
+ private:
+  const Parameters& p_;
+  const SimulationOptions& o_;
+  SimulationResult& r_;
+  double next_ = 0;
+};
+
+}  // namespace
+
+double fastest_rate(const Parameters& p) {
+  const double J = p.Jm + p.JL, F = p.Fm + p.FL;
+  // |roots of s² + a s + k| ≤ a + √k; the load's pole is FL/JL.
+  double rate = std::max({F / J + std::sqrt(p.K / J), p.Fm / p.Jm + std::sqrt(p.K / p.Jm), p.FL / p.JL});
+  return rate > 0 ? rate : 1.0;
+}
+
+SimulationResult simulate_with_odeint(const Parameters& p, const HybridState& start, const SimulationOptions& options,
+                                      const OdeintSimulationOptions& oo) {
+  SimulationResult result;
+  Recorder recorder(p, options, result);
+  const ContactSystem contact_system{p};
+  const double dt_max = oo.max_step_fraction / fastest_rate(p);
+  // Witness samples: at most dt_max / (interior_checks + 1) apart on every step (a step of
+  // dt_max gets interior_checks interior samples plus its end; shorter steps fewer).
+  const double spacing = dt_max / std::max(1, oo.interior_checks + 1);
+  auto samples_in = [spacing](double ta, double tb) {
+    return std::max(1, static_cast<int>(std::ceil((tb - ta) / spacing * (1 - 1e-12))));
+  };
+  const bool at_motor = p.measured_at == model::MeasuredAt::Motor;
+  HybridState state = start;
+  double t = 0;
+  long separations = 0;
+  std::deque<double> impacts;
+
+  auto finish = [&](SimulationStatus status) {
+    result.status = status;
+    result.t_final = t;
+    result.final_state = state;
+    result.theta_o_final = measured(p, state);
+    return result;
+  };
+  auto push_event = [&](EventKind kind, bool bounce) {
+    SimulationEvent e;
+    e.t = t;
+    e.kind = kind;
+    e.theta_o = measured(p, state);
+    e.dtheta_o = at_motor ? state.dtheta_m : state.dtheta_L;
+    e.after = state;
+    e.bounce = bounce;
+    result.events.push_back(e);
+  };
+  auto include = [&](const HybridState& h) {
+    if (!options.track_extremes) return;
+    Extremes& x = result.extremes;
+    const double o = measured(p, h);
+    x.theta_o_min = std::min(x.theta_o_min, o);
+    x.theta_o_max = std::max(x.theta_o_max, o);
+    x.theta_m_min = std::min(x.theta_m_min, h.theta_m);
+    x.theta_m_max = std::max(x.theta_m_max, h.theta_m);
+    x.theta_L_min = std::min(x.theta_L_min, h.theta_L);
+    x.theta_L_max = std::max(x.theta_L_max, h.theta_L);
+  };
+  // Extremes inside a step: the zeros of a velocity between two samples, located on the interpolant.
+  auto velocity_zero = [&](double a, double b, double va, double vb, auto velocity_at) -> std::optional<double> {
+    if (!options.track_extremes || !((va < 0 && vb >= 0) || (va > 0 && vb <= 0))) return std::nullopt;
+    return refine_root(velocity_at, a, b, va, vb);
+  };
+
+  try {
+    while (t < options.t_end) {
+      if (!finite(state)) return finish(SimulationStatus::NonFinite);
+      if (static_cast<long>(result.events.size()) >= options.max_events) return finish(SimulationStatus::EventLimit);
+      const double remaining = options.t_end - t;
+      const double t0 = t;
+
+      if (state.in_contact) {
+        // ---- contact on face σ: integrate (θo − θR, θ̇o); separation at the first zero of h = −σ·Tc.
+        const int face = state.face;
+        const ContactVector y0{measured(p, state) - p.theta_R, state.dtheta_m};
+        auto hold = [&](const ContactVector& y) { return -face * contact_torque_deviation(p, y[0], y[1]); };
+        auto at_vec = [&, face](const ContactVector& y) { return contact_on_face(p, face, p.theta_R + y[0], y[1]); };
+        include(at_vec(y0));
+        double h_prev = hold(y0), v_prev = y0[1];
+        // Starting on the separation line (Tc ≈ 0): Tc leaving toward its non-holding sign
+        // separates at once; otherwise the witness is armed once it has the holding sign.
+        bool armed = true, converged = false;
+        std::optional<double> separation;
+        if (std::fabs(h_prev) <= 1e-13 * std::max(1.0, std::fabs(y0[1]))) {
+          if (-face * contact_torque_rate(p, y0[0], y0[1]) < 0) separation = 0.0;
+          armed = false;
+        }
+        ContactVector y_end = y0;
+        if (!separation) {
+          march(contact_system, y0, remaining, dt_max, oo.tolerance, [&](double ta, double tb, auto& stepper) {
+            auto at_tau = [&](double tau) {
+              ContactVector z;
+              stepper.calc_state(tau, z);
+              return z;
+            };
+            auto samples_upto = [&](double upto) {
+              recorder.upto(t0, upto, [&](double tau) { return at_vec(at_tau(tau)); });
+            };
+            double s_prev = ta;
+            const int n = samples_in(ta, tb);
+            for (int k = 1; k <= n; ++k) {
+              const double s = sample_time(ta, tb, k, n);
+              const ContactVector y = at_tau(s);
+              const double h = hold(y);
+              std::optional<double> sep;
+              if (armed && h_prev > 0 && h <= 0) {
+                sep = refine_root([&](double tau) { return hold(at_tau(tau)); }, s_prev, s, h_prev, h);
+                if (at_rounding_level(p, at_tau(*sep))) {  // not a separation: contact holds to t_end
+                  sep.reset();
+                  armed = false;
+                  converged = true;
+                }
+              }
+              const double until = sep ? *sep : s;
+              const ContactVector y_until = sep ? at_tau(*sep) : y;
+              if (auto z = velocity_zero(s_prev, until, v_prev, y_until[1], [&](double tau) { return at_tau(tau)[1]; }))
+                include(at_vec(at_tau(*z)));
+              if (sep) {
+                separation = sep;
+                y_end = y_until;
+                samples_upto(t0 + *sep + 1e-12);
+                return true;
+              }
+              if (!armed && !converged && h > 0) armed = true;
+              h_prev = h;
+              v_prev = y[1];
+              s_prev = s;
+            }
+            const bool last = tb >= remaining;
+            samples_upto(t0 + tb + (last ? 1e-12 : 0.0));
+            if (last) y_end = at_tau(remaining);
+            return false;
+          });
+        }
+        include(at_vec(y_end));
+        if (!separation) {
+          state = at_vec(y_end);
+          t = options.t_end;
+          return finish(SimulationStatus::Completed);
+        }
+        if (*separation == 0) recorder.upto(t0, t0 + 1e-12, [&](double) { return at_vec(y0); });
+        t += *separation;
+        state = at_vec(y_end);
+        state.in_contact = false;  // face σ is now the face just left
+        push_event(EventKind::Separation, false);
+        if (options.stop_after_separations > 0 && ++separations >= options.stop_after_separations)
+          return finish(SimulationStatus::Completed);
+        continue;
+      }
+
+      // ---- free flight from the face σ left: integrate (θm − θm0, θ̇m, S·Δ, S·Δ̇).
+      const int face = state.face;
+      const double half = p.backlash / 2, S = oo.gap_scale;
+      const FreeSystem free_system{p, measured(p, state) - p.theta_R, S, at_motor};
+      const FreeFrame frame{state.theta_m, state.theta_L, S, face};
+      const FreeVector y0{0, state.dtheta_m, 0, S * (state.dtheta_L - state.dtheta_m)};
+      // Where the gap starts relative to the face σ b/2 (0 when on it, up to rounding).
+      const double x0 = state.theta_L - state.theta_m;
+      const double offset =
+          std::fabs(face * x0 - half) <= 1e-12 * std::max(1.0, p.backlash) ? 0.0 : face * x0 - half;
+      auto recombination_w = [&](const FreeVector& y) { return face * y[2] / S + offset + p.backlash; };  // ≥ 0 inside
+      auto recontact_w = [&](const FreeVector& y) { return face * y[2] / S + offset; };                   // ≤ 0 inside
+      auto speed_w = [&](const FreeVector& y) {
+        return std::max(std::fabs(y[1]), std::fabs(y[1] + y[3] / S)) - options.rest_velocity;
+      };
+      include(frame.at(y0));
+      double r_prev = recombination_w(y0), c_prev = recontact_w(y0), v_prev = speed_w(y0);
+      double vm_prev = y0[1], vL_prev = frame.at(y0).dtheta_L;
+      // Recontact is armed once the gap is strictly inside.  A gap that leaves the face with
+      // Δ'' inward and Δ''' outward turns back after about 3|Δ''/Δ'''|: the first step is
+      // kept below that so its samples see the excursion.
+      bool armed = c_prev < 0;
+      double first_step = 0;
+      if (y0[3] == 0 && offset == 0) {
+        const auto [second, third] = free_system.gap_departure(y0);
+        if (face * second < 0 && face * third > 0) first_step = 0.5 * std::fabs(second / third);
+      }
+      std::optional<double> event_tau;
+      bool opposite = false;
+      FreeVector y_event = y0, y_end = y0, y_rest = y0;
+      double rest_tau = 0;
+      march(free_system, y0, remaining, dt_max, oo.tolerance, [&](double ta, double tb, auto& stepper) {
+        auto at_tau = [&](double tau) {
+          FreeVector z;
+          stepper.calc_state(tau, z);
+          return z;
+        };
+        auto samples_upto = [&](double upto) {
+          recorder.upto(t0, upto, [&](double tau) { return frame.at(at_tau(tau)); });
+        };
+        double s_prev = ta;
+        const int n = samples_in(ta, tb);
+        for (int k = 1; k <= n; ++k) {
+          const double s = sample_time(ta, tb, k, n);
+          const FreeVector y = at_tau(s);
+          const double r = recombination_w(y), c = recontact_w(y), v = speed_w(y);
+          std::optional<double> t_opposite, t_back;
+          if (r_prev > 0 && r <= 0)
+            t_opposite = refine_root([&](double tau) { return recombination_w(at_tau(tau)); }, s_prev, s, r_prev, r);
+          // Recontact: the gap back on the face.  Unarmed and already outside means a return
+          // the samples missed (or a gap leaving outward): the bodies meet again there.
+          if (c >= 0 && (armed ? c_prev < 0 : c > 0))
+            t_back = refine_root([&](double tau) { return recontact_w(at_tau(tau)); }, s_prev, s,
+                                 std::min(c_prev, 0.0), c);
+          if (t_opposite || t_back) {
+            opposite = t_opposite && (!t_back || *t_opposite <= *t_back);
+            event_tau = opposite ? *t_opposite : *t_back;
+            y_event = at_tau(*event_tau);
+          }
+          const double until = event_tau ? *event_tau : s;
+          const HybridState h_until = frame.at(event_tau ? y_event : y);
+          if (auto z = velocity_zero(s_prev, until, vm_prev, h_until.dtheta_m, [&](double tau) { return at_tau(tau)[1]; }))
+            include(frame.at(at_tau(*z)));
+          if (auto z = velocity_zero(s_prev, until, vL_prev, h_until.dtheta_L,
+                                     [&](double tau) { return frame.at(at_tau(tau)).dtheta_L; }))
+            include(frame.at(at_tau(*z)));
+          if (event_tau) {
+            samples_upto(t0 + *event_tau + 1e-12);
+            return true;
+          }
+          if (!armed && c < 0) armed = true;
+          // Rest bookkeeping: the last time a velocity fell below rest_velocity.
+          if (v_prev >= 0 && v < 0) {
+            rest_tau = refine_root([&](double tau) { return speed_w(at_tau(tau)); }, s_prev, s, v_prev, v);
+            y_rest = at_tau(rest_tau);
+          }
+          r_prev = r;
+          c_prev = c;
+          v_prev = v;
+          vm_prev = h_until.dtheta_m;
+          vL_prev = h_until.dtheta_L;
+          s_prev = s;
+        }
+        const bool last = tb >= remaining;
+        samples_upto(t0 + tb + (last ? 1e-12 : 0.0));
+        if (last) y_end = at_tau(remaining);
+        return false;
+      }, first_step);
+      include(frame.at(event_tau ? y_event : y_end));
+
+      if (!event_tau) {
+        const HybridState end = frame.at(y_end);
+        if (speed_w(y_end) < 0) {
+          const double t_end = t + remaining;
+          t += rest_tau;
+          state = frame.at(y_rest);
+          push_event(EventKind::Rest, false);
+          t = t_end;
+          state = end;
+          return finish(SimulationStatus::Rest);
+        }
+        state = end;
+        t = options.t_end;
+        return finish(SimulationStatus::Completed);
+      }
+      t += *event_tau;
+      // Inelastic impact (eq. 24) on the face hit.
+      const HybridState before = frame.at(y_event);
+      const int face_hit = opposite ? -face : face;
+      const double omega = (p.Jm * before.dtheta_m + p.JL * before.dtheta_L) / (p.Jm + p.JL);
+      const double theta_o = measured(p, before);
+      state = contact_on_face(p, face_hit, theta_o, omega);
+      const double tc = contact_torque(p, theta_o, omega);
+      const bool holds = -face_hit * tc >= -1e-14 * std::max(1.0, std::fabs(tc));
+      if (!holds) state.in_contact = false;  // a bounce: the bodies part again at once
+      push_event(opposite ? EventKind::Recombination : EventKind::Recontact, !holds);
+      impacts.push_back(t);
+      while (!impacts.empty() && impacts.front() < t - options.zeno_window) impacts.pop_front();
+      if (static_cast<int>(impacts.size()) >= options.zeno_impacts) return finish(SimulationStatus::Chattering);
+    }
+  } catch (const NonFiniteState&) {
+    return finish(SimulationStatus::NonFinite);
+  } catch (const odeint::step_adjustment_error&) {
+    return finish(SimulationStatus::NonFinite);
+  } catch (const odeint::no_progress_error&) {
+    return finish(SimulationStatus::NonFinite);
+  }
+  return finish(SimulationStatus::Completed);
+}
+
+SimulationResult simulate_step_with_odeint(const Parameters& p, double step, const SimulationOptions& options,
+                                           const OdeintSimulationOptions& odeint_options) {
+  return simulate_with_odeint(p, step_start(p, step), options, odeint_options);
+}
+
+}  // namespace backlash::numeric
