@@ -89,7 +89,6 @@ Flight flight_from_state(const Parameters& p, const HybridState& start) {
   SmallVector x0(4);
   x0 << start.theta_m, start.dtheta_m, start.theta_L, start.dtheta_L;
   auto flight = std::make_shared<LinearFlight>(free_mode_segment(p), x0);
-  const double gap0 = start.theta_L - start.theta_m;
   Flight f;
   f.vector = [flight](double tau) { return flight->state(tau); };
   f.at = [flight, face = start.face](double tau) {
@@ -103,9 +102,9 @@ Flight flight_from_state(const Parameters& p, const HybridState& start) {
     h.dtheta_L = x(3);
     return h;
   };
-  f.gap_change = [flight, gap0](double tau) {
-    const SmallVector x = flight->state(tau);
-    return x(2) - x(0) - gap0;
+  f.gap_change = [flight](double tau) {
+    const SmallVector dx = flight->change(tau);
+    return dx(2) - dx(0);
   };
   return f;
 }

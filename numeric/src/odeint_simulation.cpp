@@ -13,6 +13,7 @@
 #include <exception>
 #include <limits>
 #include <optional>
+#include <utility>
 
 namespace backlash::numeric {
 

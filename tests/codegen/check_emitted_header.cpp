@@ -161,6 +161,38 @@ TEST(EmittedHeader, custom_case_file_compiles_stand_alone_and_gives_the_exact_va
   fs::remove_all(dir);
 }
 
+TEST(GeneratedHeaders, build_time_headers_compile_stand_alone_with_pedantic_warnings) {
+  // every header backlash_codegen wrote at build time, together: the eight cases and the branches
+  const fs::path dir = fresh_directory("generated_headers");
+  std::ofstream(dir / "main.cpp") << R"cpp(#include "backlash/generated/cases.hpp"
+#include "backlash/generated/branches.hpp"
+#include <cstdio>
+int main() {
+  namespace g = backlash::generated;
+  const g::branches::Parameters p{g::case_V::Jm, g::case_V::Fm, g::case_V::JL, g::case_V::FL, g::case_V::K, g::case_V::theta_R};
+  const auto a = g::case_V::free_state(2.5, 0.3);
+  const auto b = g::branches::load_generic::free_state(p, 2.5, 0.3);
+  std::printf("%a %a %a %a\n", a.theta_m, b.theta_m, a.gap, b.gap);
+  return 0;
+}
+)cpp";
+  const CommandResult compiled =
+      run(std::string(BACKLASH_CXX_COMPILER) + " -std=c++20 -Wall -Wextra -Werror -pedantic -O2 -I" +
+          quote(BACKLASH_GENERATED_DIR) + " " + quote(dir / "main.cpp") + " -o " + quote(dir / "program"));
+  ASSERT_EQ(compiled.status, 0) << "the generated headers do not compile stand-alone:\n" << compiled.output;
+  const CommandResult ran = run(quote(dir / "program"));
+  ASSERT_EQ(ran.status, 0) << ran.output;
+  std::istringstream in(ran.output);
+  std::string w[4];
+  in >> w[0] >> w[1] >> w[2] >> w[3];
+  const double case_theta = std::strtod(w[0].c_str(), nullptr), branch_theta = std::strtod(w[1].c_str(), nullptr);
+  const double case_gap = std::strtod(w[2].c_str(), nullptr), branch_gap = std::strtod(w[3].c_str(), nullptr);
+  EXPECT_NEAR(branch_theta, case_theta, 1e-12) << "load_generic theta_m returned " << branch_theta << " instead of "
+                                               << case_theta;
+  EXPECT_NEAR(branch_gap, case_gap, 1e-12) << "load_generic gap returned " << branch_gap << " instead of " << case_gap;
+  fs::remove_all(dir);
+}
+
 TEST(EmittedHeader, depends_only_on_cmath_and_carries_banner_and_hash) {
   const auto spec = backlash::model::load_case("VII");
   const std::string header = backlash::codegen::emit_case_files(spec).front().content;

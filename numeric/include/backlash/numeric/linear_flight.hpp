@@ -15,6 +15,9 @@ class LinearFlight {
  public:
   LinearFlight(LinearSegment segment, SmallVector x0);
   SmallVector state(double t) const;
+  /// x(t) − x(0) = ∫₀ᵗ e^{As} ds (A x0 + c), from one augmented exponential: no subtraction of
+  /// absolute positions, so a gap that has barely left a face keeps its relative accuracy.
+  SmallVector change(double t) const;
   const LinearSegment& segment() const { return segment_; }
 
  private:
