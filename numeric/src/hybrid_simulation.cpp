@@ -236,12 +236,22 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
       w.A = contact_segment.A;
       w.c = contact_segment.c;
       w.e = torque.r;
-      w.level = -torque.r0;  // w = Tc
+      w.level = 0;  // w = Tc, given directly by `value` below (eᵀx' and its bounds need no level)
       w.state = [&evaluator, theta0, omega0](double tau) {
         const ContactState c = evaluator.contact_state(tau, theta0, omega0);
         SmallVector y(2);
         y << c.theta_o, c.dtheta_o;
         return y;
+      };
+      // Tc = (JL K/J)(θR − θo) + (FL − JL F/J) θ̇o without the cancellation θR − θo: by
+      // linearity θo − θR = (θo0 − θR)·a(τ) + θ̇o0·b(τ) with the unit responses a, b of the
+      // validated closed form, so the rounding error scales with the motion, not with θR.
+      w.value = [&evaluator, &p, &torque, theta0, omega0](double tau) {
+        const double a = evaluator.contact_state(tau, p.theta_R + 1, 0).theta_o - p.theta_R;
+        const double b = evaluator.contact_state(tau, p.theta_R, 1).theta_o - p.theta_R;
+        const double deviation = (theta0 - p.theta_R) * a + omega0 * b;
+        const double velocity = evaluator.contact_state(tau, theta0, omega0).dtheta_o;
+        return torque.r(0) * deviation + torque.r(1) * velocity;
       };
       const int face = state.face;
       auto at = [&evaluator, &p, theta0, omega0, face](double tau) {

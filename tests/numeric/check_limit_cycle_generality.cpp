@@ -100,3 +100,23 @@ TEST(HybridSimulationGenerality, MotorMeasuredCasesSettle) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(HybridSimulationGenerality, EventTimesDoNotDependOnTheReference) {
+  // Shift invariance: θR = 1000 must give the events of θR = 1 (the separation witness Tc is
+  // evaluated from the deviation θo − θR, never by cancelling two large numbers).
+  Parameters p = load_measured(0.5, 0.1, 0.5, 0.3);
+  const ValidatedEvaluator near = validated(p);
+  p.theta_R = 1000;
+  const ValidatedEvaluator far = validated(p);
+  SimulationOptions o;
+  o.t_end = 60;
+  const SimulationResult a = simulate_step(near, 0.62, o), b = simulate_step(far, 0.62, o);
+  ASSERT_EQ(a.events.size(), b.events.size());
+  double worst = 0;
+  for (size_t i = 0; i < a.events.size(); ++i) worst = std::max(worst, std::fabs(a.events[i].t - b.events[i].t));
+  EXPECT_LT(worst, 1e-9) << "event times moved by " << worst << " when theta_R went from 1 to 1000";
+}
+
+}  // namespace
