@@ -4,7 +4,7 @@
 #include "backlash/numeric/segment_dynamics.hpp"
 #include "gap_events.hpp"
 
-#include <boost/math/tools/minima.hpp>
+#include <boost/math/tools/roots.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -76,51 +76,111 @@ DividingLinePoint dividing_line_point(const ValidatedEvaluator& evaluator, doubl
 
 namespace {
 
-// sup over the free flight (until the gap returns to 0, or the horizon) of gap/θ̇m0.
-// gap is linear in θ̇m0 (θR cancels), so the unit-velocity flight decides every θ̇m0 > 0.
-std::optional<double> recombination_threshold(const ValidatedEvaluator& evaluator, double horizon) {
-  const Parameters& p = evaluator.parameters();
-  if (p.backlash <= 0) return std::nullopt;
+// The unit flight.  From the separation line the free-mode deviations from θR are linear in
+// θ̇m0 (θR cancels in the gap), so gap(t; θ̇m0) = θ̇m0·f(t) with f = gap(t; 1): one profile
+// serves the whole dividing line.  Its knots are the certified departure t0, the certified
+// zeros of f' (in order), and `end`, the first return of f to 0 (or the horizon); f is
+// monotone between consecutive knots.
+struct UnitGapProfile {
+  bool valid = false;
+  double end = 0;
+  bool returns = false;  ///< f returns to 0 at `end` (recontact on the face left)
+  std::vector<double> knots, values;
+};
+
+UnitGapProfile unit_gap_profile(const ValidatedEvaluator& evaluator, double horizon) {
+  UnitGapProfile profile;
   const double unit = 1.0;
   const std::optional<double> t0 = return_search_start(evaluator, unit);
-  if (!t0) return std::nullopt;
-  const auto back = first_crossing(gap_witness(evaluator, unit, 0), *t0, horizon);
-  const double end = back ? back->t : horizon;
-  // Maxima of the gap: zeros of its slope θ̇L − θ̇m, certified in turn.
-  const LinearSegment s = free_mode_segment(p);
-  LinearWitness slope;
-  slope.A = s.A;
-  slope.c = s.c;
+  if (!t0) return profile;
+  const LinearWitness gap = gap_witness(evaluator, unit, 0);
+  const auto back = first_crossing(gap, *t0, horizon);
+  profile.valid = true;
+  profile.returns = back.has_value();
+  profile.end = back ? back->t : horizon;
+  LinearWitness slope = gap;  // zeros of f' = θ̇L − θ̇m
   slope.e = SmallRow::Zero(4);
   slope.e(1) = -1;
   slope.e(3) = 1;
-  slope.state = gap_witness(evaluator, unit, 0).state;
-  double best = evaluator.free_state(end, unit).gap;
+  slope.value = nullptr;
+  auto add = [&](double t) {
+    profile.knots.push_back(t);
+    profile.values.push_back(t == profile.end && back ? 0.0 : evaluator.free_state(t, unit).gap);
+  };
+  add(*t0);
   double t = *t0;
-  while (true) {
-    const auto critical = first_crossing(slope, t, end);
+  while (t < profile.end) {
+    const auto critical = first_crossing(slope, t, profile.end);
     if (!critical) break;
-    best = std::max(best, evaluator.free_state(critical->t, unit).gap);
-    t = critical->t + 1e-9 * std::max(1.0, critical->t);
-    if (t >= end) break;
+    add(critical->t);
+    t = critical->t + 1e-12 * std::max(1.0, critical->t);
   }
-  // If the gap can grow without bound (it still rises at the horizon), every θ̇m0 recombines.
-  const FreeState at_end = evaluator.free_state(end, unit);
-  if (!back && at_end.dtheta_L - at_end.dtheta_m > 1e-9) return std::nullopt;
-  if (best <= 0) return std::nullopt;
-  return p.backlash / best;
+  add(profile.end);
+  return profile;
+}
+
+// First t with f(t) = level on the profile (monotone pieces in order), or nothing.
+std::optional<Crossing> first_level_crossing(const ValidatedEvaluator& evaluator, const UnitGapProfile& profile, double level) {
+  const auto f = [&evaluator, level](double t) { return evaluator.free_state(t, 1.0).gap - level; };
+  for (size_t i = 0; i + 1 < profile.knots.size(); ++i) {
+    const double a = profile.knots[i], b = profile.knots[i + 1];
+    const double fa = profile.values[i] - level, fb = profile.values[i + 1] - level;
+    if (fa == 0) return Crossing{a, true, 0};  // touches the level at a maximum: grazing
+    if ((fa > 0) == (fb > 0) && fb != 0) continue;
+    if (fb == 0) return Crossing{b, i + 2 < profile.knots.size(), 0};
+    boost::uintmax_t iterations = 200;
+    const auto root = boost::math::tools::toms748_solve(
+        f, a, b, fa, fb, [](double lo, double hi) { return hi - lo <= 1e-14 * std::max(1.0, std::fabs(hi)); }, iterations);
+    return Crossing{0.5 * (root.first + root.second), false, 0};
+  }
+  return std::nullopt;
+}
+
+DividingLinePoint point_from_profile(const ValidatedEvaluator& evaluator, const UnitGapProfile& profile, double v0) {
+  const Parameters& p = evaluator.parameters();
+  DividingLinePoint point;
+  point.dtheta_m0 = v0;
+  if (v0 == 0 || p.backlash <= 0 || !profile.valid) return point;
+  // gap = v0·f reaches the opposite face copysign(b, v0) where f = b/|v0|.
+  if (const auto hit = first_level_crossing(evaluator, profile, p.backlash / std::fabs(v0))) {
+    point.status = RecombinationStatus::Recombination;
+    point.t = hit->t;
+    point.grazing = hit->grazing;
+  } else if (profile.returns) {
+    point.status = RecombinationStatus::Recontact;
+    point.t = profile.end;
+  } else {
+    return point;
+  }
+  const FreeState f = evaluator.free_state(point.t, v0);
+  point.theta_m = f.theta_m;
+  point.dtheta_m = f.dtheta_m;
+  point.theta_L = f.theta_L;
+  point.dtheta_L = f.dtheta_L;
+  point.theta_o = p.measured_at == model::MeasuredAt::Motor ? f.theta_m : f.theta_L;
+  point.dtheta_o = recombined_velocity(p, f.dtheta_m, f.dtheta_L);
+  return point;
 }
 
 }  // namespace
 
 DividingLines trace_dividing_lines(const ValidatedEvaluator& evaluator, const std::vector<double>& grid,
                                    const TraceOptions& options) {
+  const Parameters& p = evaluator.parameters();
   DividingLines lines;
   lines.cot_phi = evaluator.cot_phi();
-  lines.horizon = horizon_of(evaluator.parameters(), options);
-  lines.threshold = recombination_threshold(evaluator, lines.horizon);
+  lines.horizon = horizon_of(p, options);
+  const UnitGapProfile profile = unit_gap_profile(evaluator, lines.horizon);
+  // Threshold: b / sup f before the return; none when f still rises at the horizon (it grows without bound).
+  if (profile.valid && p.backlash > 0) {
+    double sup = 0;
+    for (double v : profile.values) sup = std::max(sup, v);
+    const FreeState at_end = evaluator.free_state(profile.end, 1.0);
+    const bool unbounded = !profile.returns && at_end.dtheta_L - at_end.dtheta_m > 1e-9;
+    if (!unbounded && sup > 0) lines.threshold = p.backlash / sup;
+  }
   lines.points.reserve(grid.size());
-  for (double v0 : grid) lines.points.push_back(dividing_line_point(evaluator, v0, options));
+  for (double v0 : grid) lines.points.push_back(point_from_profile(evaluator, profile, v0));
   return lines;
 }
 

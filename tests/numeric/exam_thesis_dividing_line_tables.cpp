@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <map>
 
@@ -70,5 +71,24 @@ TEST(Table27_CaseVII_DividingLines, MotorAndLoadAtRecombination) { check_table("
 TEST(Table28_CaseVII_DividingLines, RecombinedVelocity) { check_table("Table28"); }
 TEST(Table30_CaseVIII_DividingLines, MotorAndLoadAtRecombination) { check_table("Table30"); }
 TEST(Table31_CaseVIII_DividingLines, RecombinedVelocity) { check_table("Table31"); }
+
+}  // namespace
+
+namespace {
+
+// The dividing line is traced from one certified profile of the unit flight (gap linear in
+// θ̇m0); each point is also found by its own certified search: both must agree.
+TEST(DividingLinesAllCases, ProfileAndPointwiseSearchesAgree) {
+  std::vector<double> grid;
+  for (int k = 0; k <= 60; ++k) grid.push_back(0.005 * std::pow(400.0, k / 60.0));
+  for (const std::string& id : model::thesis_case_ids()) {
+    const numeric::DividingLines lines = numeric::trace_dividing_lines(validated(id), grid);
+    for (const numeric::DividingLinePoint& p : lines.points) {
+      const numeric::DividingLinePoint q = numeric::dividing_line_point(validated(id), p.dtheta_m0);
+      ASSERT_EQ(p.status, q.status) << "case " << id << " v0 = " << p.dtheta_m0;
+      EXPECT_NEAR(p.t, q.t, 1e-11 * std::max(1.0, q.t)) << "case " << id << " v0 = " << p.dtheta_m0;
+    }
+  }
+}
 
 }  // namespace
