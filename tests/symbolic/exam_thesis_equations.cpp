@@ -484,6 +484,45 @@ TEST(Eq128_Eq129_CaseVIII_Load, DeceleratingLoad) {
   expect_printed("Eq129", "VIII", "velocity coefficient", per_v0(d, d.free.load_velocity.solution, 0, numeric(-1, 8)), "1");
 }
 
+
+// ---------------------------------------------------------------- Laplace forms of cases I, II and the separation isoclines
+
+TEST(Eq49_CaseI_ThetaMLaplace, ClosedLoopMotorTransform) {
+  // Θm = (1.666/s + s θm0 + .8 θm0 + θ̇m0)/(s² + .8 s + 1.666), θm0 = 1 on case I's separation line.
+  const CaseDerivation& d = thesis_case("I");
+  const ex k = d.parameters.K / d.parameters.Jm, a = d.parameters.Fm / d.parameters.Jm, theta0 = d.free.separation_theta;
+  const ex eq49 = (k / s() + s() * theta0 + a * theta0 + v0()) / (s() * s() + a * s() + k);
+  EXPECT_TRUE(same(d.free.motor_position.laplace, eq49)) << "returned " << d.free.motor_position.laplace;
+  expect_printed("Eq49", "I", "K/Jm", k, "1.666");
+  expect_printed("Eq49", "I", "Fm/Jm", a, ".8");
+}
+
+TEST(Eq61_CaseII_ThetaMLaplace, ClosedLoopMotorTransform) {
+  // Printed "(2/s + θ̇m0 + 5θm0 + .4θm0)/(s² + .4s + 2)": the "5θm0" is the OCR of "sθm0".
+  const CaseDerivation& d = thesis_case("II");
+  const ex theta0 = d.free.separation_theta;
+  const ex eq61 = (2 / s() + v0() + s() * theta0 + numeric(2, 5) * theta0) / (s() * s() + numeric(2, 5) * s() + 2);
+  EXPECT_TRUE(same(d.free.motor_position.laplace, eq61)) << "returned " << d.free.motor_position.laplace;
+}
+
+// At separation the motor-alone isocline reads η2 + Fm/Jm = (K/Jm)(1 − θm0)/θ̇m0, i.e.
+// θ̇m0/(1 − θm0) = (K/Jm)/(η2 + Fm/Jm); with η2 = η3 it is the separation line.
+void expect_separation_isocline(const std::string& eq_friction, const std::string& eq_tangent, const std::string& id,
+                                const char* friction, const char* gain) {
+  const CaseDerivation& d = thesis_case(id);
+  const CaseParameters& p = d.parameters;
+  expect_printed(eq_friction, id, "Fm/Jm", p.Fm / p.Jm, friction);
+  expect_printed(eq_friction, id, "K/Jm", p.K / p.Jm, gain);
+  // The tangent at η2 = η3 is −1/cot φ (θ̇/(1 − θ) on θ = 1 + cot φ θ̇).
+  const ex tangent = (p.K / p.Jm) / (d.free.eta_separation + p.Fm / p.Jm);
+  EXPECT_TRUE(same(tangent, -1 / d.free.cot_phi)) << eq_tangent << " case " << id << ": returned " << tangent;
+}
+
+TEST(Eq88_Eq90_CaseV_SeparationIsoclineForm, Coefficients) { expect_separation_isocline("Eq88", "Eq90", "V", "0.2", "2"); }
+TEST(Eq99_Eq101_CaseVI_SeparationIsoclineForm, Coefficients) { expect_separation_isocline("Eq99", "Eq101", "VI", ".6", "2"); }
+TEST(Eq110_Eq112_CaseVII_SeparationIsoclineForm, Coefficients) { expect_separation_isocline("Eq110", "Eq112", "VII", ".5", "5"); }
+TEST(Eq122_Eq124_CaseVIII_SeparationIsoclineForm, Coefficients) { expect_separation_isocline("Eq122", "Eq124", "VIII", "1.5", "5"); }
+
 // ---------------------------------------------------------------- every segment of every case verifies
 
 TEST(Eq6_Eq15_Eq25_AllCases_ContactMode, ExactSolutionVerified) {
