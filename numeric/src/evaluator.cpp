@@ -99,21 +99,20 @@ const GeneratedCase* find_case(const std::string& id) {
 
 class ParametricEvaluator final : public SegmentEvaluator {
  public:
-  explicit ParametricEvaluator(const Parameters& p) : p_(p), branches_(select_branches(p)), cot_(numeric::cot_phi(p)) {}
+  explicit ParametricEvaluator(const Parameters& p) : segments_(p), branches_(select_branches(p)) {}
   std::string name() const override { return "parametric (stable)"; }
   std::string kind() const override { return "parametric"; }
-  const Parameters& parameters() const override { return p_; }
+  const Parameters& parameters() const override { return segments_.parameters(); }
   BranchSelection branches() const override { return branches_; }
-  double cot_phi() const override { return cot_; }
-  FreeState free_state(double t, double v0) const override { return numeric::free_state(p_, t, v0); }
+  double cot_phi() const override { return segments_.cot_phi(); }
+  FreeState free_state(double t, double v0) const override { return segments_.free_state(t, v0); }
   ContactState contact_state(double t, double x0, double v0) const override {
-    return numeric::contact_state(p_, t, x0, v0);
+    return segments_.contact_state(t, x0, v0);
   }
 
  private:
-  Parameters p_;
+  StableSegments segments_;
   BranchSelection branches_;
-  double cot_;
 };
 
 class DirectEvaluator final : public SegmentEvaluator {

@@ -101,43 +101,59 @@ BranchSelection select_branches(const Parameters& p) {
 
 double cot_phi(const Parameters& p) { return (p.Jm * p.FL - p.Fm * p.JL) / (p.K * p.JL); }
 
-FreeState free_state(const Parameters& p, double t, double v0) {
+StableSegments::StableSegments(const Parameters& p)
+    : p_(p),
+      at_load_(p.measured_at == model::MeasuredAt::Load),
+      cot_(numeric::cot_phi(p)),
+      a_(p.Fm / p.Jm),
+      b_(p.FL / p.JL),
+      k_(p.K / p.Jm),
+      a_minus_b_(a_ - b_),
+      gap_factor_(k_ - b_ * a_minus_b_),
+      alpha_m_(p.Fm / (2 * p.Jm)),
+      w2_m_(p.K / p.Jm),
+      alpha_c_((p.Fm + p.FL) / (2 * (p.Jm + p.JL))),
+      w2_c_(p.K / (p.Jm + p.JL)) {}
+
+FreeState StableSegments::free_state(double t, double v0) const {
   FreeState s;
-  const double b = p.FL / p.JL;
-  const double y = -b * t;
-  const double theta0 = p.theta_R + cot_phi(p) * v0;
-  if (p.measured_at == model::MeasuredAt::Load) {
-    const double a = p.Fm / p.Jm, k = p.K / p.Jm;
-    const LoadKernels q = load_kernels(-a * t, y);
-    const double a_minus_b = a - b;
+  const double y = -b_ * t;
+  const double theta0 = p_.theta_R + cot_ * v0;
+  if (at_load_) {
+    const LoadKernels q = load_kernels(-a_ * t, y);
     const double t2 = t * t, t3 = t2 * t;
     s.theta_L = theta0 + v0 * t * q.phi1_y;
     s.dtheta_L = v0 * q.exp_y;
-    s.theta_m = theta0 + v0 * (t * q.phi1_x + a_minus_b * t2 * q.phi2_x - k * t3 * q.a2);
-    s.dtheta_m = v0 * (q.exp_x + a_minus_b * t * q.phi1_x - k * t2 * q.a1);
-    s.gap = v0 * (k - b * a_minus_b) * t3 * q.a2;
+    s.theta_m = theta0 + v0 * (t * q.phi1_x + a_minus_b_ * t2 * q.phi2_x - k_ * t3 * q.a2);
+    s.dtheta_m = v0 * (q.exp_x + a_minus_b_ * t * q.phi1_x - k_ * t2 * q.a1);
+    s.gap = v0 * gap_factor_ * t3 * q.a2;
   } else {
-    const double phi1_y = phi(1, y);
+    const ExpPhi1 load = exp_phi1(y);
+    const double phi1_y = load.phi1_x;
     s.theta_L = theta0 + v0 * t * phi1_y;
-    s.dtheta_L = v0 * (1.0 + y * phi1_y);
-    const double alpha = p.Fm / (2 * p.Jm), w2 = p.K / p.Jm;
-    const double e0 = theta0 - p.theta_R;
-    const DampedPair q = damped_pair(alpha, w2, t);
-    const double e = e0 * q.c + (v0 + alpha * e0) * q.s;
-    s.theta_m = p.theta_R + e;
-    s.dtheta_m = v0 * q.c - (alpha * v0 + w2 * e0) * q.s;
+    s.dtheta_L = v0 * load.exp_x;
+    const double e0 = theta0 - p_.theta_R;
+    const DampedPair q = damped_pair(alpha_m_, w2_m_, t);
+    const double e = e0 * q.c + (v0 + alpha_m_ * e0) * q.s;
+    s.theta_m = p_.theta_R + e;
+    s.dtheta_m = v0 * q.c - (alpha_m_ * v0 + w2_m_ * e0) * q.s;
     // θL − θm = (θ0 − θR) + θ̇m0 t φ1(y) − e(t)
     s.gap = e0 + v0 * t * phi1_y - e;
   }
   return s;
 }
 
+ContactState StableSegments::contact_state(double t, double theta_o0, double dtheta_o0) const {
+  const double e0 = theta_o0 - p_.theta_R;
+  const DampedPair q = damped_pair(alpha_c_, w2_c_, t);
+  return {p_.theta_R + e0 * q.c + (dtheta_o0 + alpha_c_ * e0) * q.s,
+          dtheta_o0 * q.c - (alpha_c_ * dtheta_o0 + w2_c_ * e0) * q.s};
+}
+
+FreeState free_state(const Parameters& p, double t, double v0) { return StableSegments(p).free_state(t, v0); }
+
 ContactState contact_state(const Parameters& p, double t, double theta_o0, double dtheta_o0) {
-  const double J = p.Jm + p.JL, F = p.Fm + p.FL;
-  const double alpha = F / (2 * J), w2 = p.K / J;
-  const double e0 = theta_o0 - p.theta_R;
-  const DampedPair q = damped_pair(alpha, w2, t);
-  return {p.theta_R + e0 * q.c + (dtheta_o0 + alpha * e0) * q.s, dtheta_o0 * q.c - (alpha * dtheta_o0 + w2 * e0) * q.s};
+  return StableSegments(p).contact_state(t, theta_o0, dtheta_o0);
 }
 
 const std::vector<BranchRepresentative>& branch_representatives() {

@@ -91,9 +91,10 @@ double exp_divided_difference(int n, double x, double y) {
 
 namespace {
 
-// Σ_j h_j(x, y)/(j+n+1)! for n = 1 and 2 at once (max(|x|,|y|) ≤ m ≤ 1).
+// Σ_j h_j(x, y)/(j+n+1)! for n = 1 and 2 at once (max(|x|,|y|) ≤ m ≤ 1); the
+// first omitted term (J+1)·m^J/(J+2)! stays below 2^-56.
 void pair_series(double x, double y, double m, double& a1, double& a2) {
-  const int terms = series_terms(m) + 4;
+  const int terms = m <= 1.0 / 64 ? 7 : m <= 1.0 / 8 ? 10 : m <= 0.25 ? 13 : 23;
   double h = 1.0, xp = 1.0;
   a1 = inverse_factorial[2];
   a2 = inverse_factorial[3];
@@ -109,19 +110,35 @@ struct PhiPair {
   double e, phi1, phi2;
 };
 
+// e^x, φ1(x), φ2(x): one Horner series (φ1 = 1 + xφ2, e^x = 1 + xφ1) for
+// |x| < 1/8; else expm1 and φ2 = (φ1 − 1)/x, which loses at most a factor 16.
 PhiPair phi_pair(double x) {
   const double ax = std::fabs(x);
-  if (ax < 1.0) {
-    const int terms = series_terms(ax);
-    const double phi1 = phi_series(1, x, terms + 1);
-    return {1.0 + x * phi1, phi1, phi_series(2, x, terms)};
+  if (ax < 0.125) {
+    const double phi2 = phi_series(2, x, series_terms(ax));
+    const double phi1 = 1.0 + x * phi2;
+    return {1.0 + x * phi1, phi1, phi2};
   }
-  const double em1 = std::expm1(x);
+  // one libm call: e^x − 1 does not cancel for x < −1, 1 + expm1(x) keeps e^x's
+  // relative accuracy for x ≥ −1
+  double e, em1;
+  if (x < -1.0) {
+    e = std::exp(x);
+    em1 = e - 1.0;
+  } else {
+    em1 = std::expm1(x);
+    e = em1 + 1.0;
+  }
   const double phi1 = em1 / x;
-  return {em1 + 1.0, phi1, (phi1 - 1.0) / x};
+  return {e, phi1, (phi1 - 1.0) / x};
 }
 
 }  // namespace
+
+ExpPhi1 exp_phi1(double x) {
+  const PhiPair p = phi_pair(x);
+  return {p.e, p.phi1};
+}
 
 LoadKernels load_kernels(double x, double y) {
   const PhiPair px = phi_pair(x), py = phi_pair(y);
@@ -129,9 +146,10 @@ LoadKernels load_kernels(double x, double y) {
   const double ax = std::fabs(x), ay = std::fabs(y);
   const double m = ax > ay ? ax : ay;
   const double d = x - y;
-  if (m <= 1.0) {
+  if (m <= 0.25 || (m <= 1.0 && std::fabs(d) < 0.25 * m)) {
     pair_series(x, y, m, k.a1, k.a2);
   } else if (std::fabs(d) >= 0.25 * m) {
+    // separated nodes (m > 1/4): the difference quotients lose at most ~100 ulp
     k.a1 = (px.phi1 - py.phi1) / d;
     k.a2 = (px.phi2 - py.phi2) / d;
   } else {

@@ -92,14 +92,20 @@ ex canonical_sqrt(const ex& square) {
   if (!value.is_rational()) throw std::invalid_argument("canonical_sqrt: square is not rational: " + text(square));
   if (value.is_negative()) throw std::invalid_argument("canonical_sqrt: negative square " + text(square));
   if (value.is_zero()) return 0;
-  // sqrt(p/q) = sqrt(p q)/q; p q = a² r with r square-free.
+  // sqrt(p/q) = sqrt(p q)/q; p q = a² r.  Square factors below 2^16 are extracted by trial
+  // division and a remaining perfect square exactly (isqrt), so r is square-free for every
+  // radicand met in practice and the cost stays bounded for huge ones (FL = 1e-14 gives ~1e30).
   numeric product = value.numer() * value.denom();
   numeric outside = 1;
   numeric inside = 1;
   numeric remaining = product;
-  for (numeric d = 2; d * d <= remaining; d = d + 1) {
+  for (numeric d = 2; d <= 65536 && d * d <= remaining; d = d + 1) {
     while (irem(remaining, d * d).is_zero()) { remaining = remaining / (d * d); outside = outside * d; }
     if (irem(remaining, d).is_zero()) { remaining = remaining / d; inside = inside * d; }
+  }
+  if (const numeric root = isqrt(remaining); root * root == remaining) {
+    outside = outside * root;
+    remaining = 1;
   }
   inside = inside * remaining;
   const numeric coefficient = outside / value.denom();

@@ -3,6 +3,8 @@
 // continuity across the switches between series and closed forms.
 #include "backlash/numeric/phi_functions.hpp"
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -135,6 +137,33 @@ TEST(DampedPair, known_values_far_from_critical) {
   const auto p = damped_pair(2.5, 4, t);
   EXPECT_LE(std::fabs(p.c / (0.5 * (std::exp(-t) + std::exp(-4 * t))) - 1), 1e-14);
   EXPECT_LE(std::fabs(p.s / ((std::exp(-t) - std::exp(-4 * t)) / 3) - 1), 1e-14);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(LoadKernels, agree_with_the_long_double_references_everywhere) {
+  const double xs[] = {0.0, -1e-9, -0.01, -0.1, -0.124, -0.126, -0.2, -0.26, -0.5, -0.9, -1.0, -1.1, -3.0, -7.0, -60.0};
+  for (double x : xs)
+    for (double y : xs)
+      for (double shift : {0.0, 1e-12, 1e-6, 1e-2}) {
+        const double yy = y - shift;
+        const auto k = backlash::numeric::load_kernels(x, yy);
+        const auto check = [&](const char* what, double actual, long double expected) {
+          const double error = std::fabs(static_cast<double>(actual - expected)) / std::fabs(static_cast<double>(expected));
+          EXPECT_LE(error, 5e-14) << what << "(" << x << ", " << yy << ") returned " << actual << " instead of "
+                                  << static_cast<double>(expected);
+        };
+        check("exp_x", k.exp_x, std::exp(static_cast<long double>(x)));
+        check("exp_y", k.exp_y, std::exp(static_cast<long double>(yy)));
+        check("phi1_x", k.phi1_x, phi_reference(1, x));
+        check("phi2_x", k.phi2_x, phi_reference(2, x));
+        check("phi1_y", k.phi1_y, phi_reference(1, yy));
+        // divided differences: against the independently tested exp_divided_difference
+        check("A1", k.a1, exp_divided_difference(1, x, yy));
+        check("A2", k.a2, exp_divided_difference(2, x, yy));
+      }
 }
 
 }  // namespace

@@ -97,3 +97,23 @@ TEST_F(Fixture, check_RandomRationalQuadraticsVerify) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(CanonicalSqrt, exam_PerfectSquaresWithLargePrimeFactorsAreRational) {
+  // 1000003 is prime and above the trial-division bound: its square must still be recognised.
+  const GiNaC::numeric p("1000003"), q("999983");
+  const GiNaC::ex root = backlash::symbolic::canonical_sqrt(GiNaC::numeric(p * p) / GiNaC::numeric(q * q * 4));
+  EXPECT_TRUE(GiNaC::is_a<GiNaC::numeric>(root)) << "returned " << root << " instead of 1000003/1999966";
+  EXPECT_EQ(root, GiNaC::ex(p / (q * 2)));
+  EXPECT_EQ(backlash::symbolic::canonical_sqrt(GiNaC::numeric(113, 75)), GiNaC::ex(GiNaC::numeric(1, 15) * sqrt(GiNaC::ex(339))));
+}
+
+TEST(CanonicalSqrt, exam_HugeRadicandStaysExact) {
+  // FL = 1e-14 gives radicands of ~1e30: the result squares back exactly.
+  const GiNaC::numeric square("123456789012345678901234567891/100000000000000000000000000000");
+  const GiNaC::ex root = backlash::symbolic::canonical_sqrt(square);
+  EXPECT_TRUE(GiNaC::normal(GiNaC::expand(root * root) - square).is_zero()) << "returned " << root;
+}
+
+}  // namespace

@@ -10,6 +10,8 @@
 //   metadata    case id, branches, parameter order and exact values, input hash
 //   latex       the exact expression of every state, as LaTeX strings
 // Every exp/cos/sin is hoisted into a named constant (e_m1_5 = exp(-t/5));
+// decaying rational rates that are small multiples (≤ 16) of a common rate
+// share one exp by binary powering (e_m3_5 = e_m1_5*e_m1_5_p2);
 // frequencies (square roots) are named constexpr constants; numbers are exact
 // rationals written as "p.0/q.0" (p, q exact in a double: one correctly
 // rounded division, never C integer division) or, when irrational, the

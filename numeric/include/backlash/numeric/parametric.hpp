@@ -85,6 +85,24 @@ double cot_phi(const Parameters& p);
 FreeState free_state(const Parameters& p, double t, double dtheta_m0);
 ContactState contact_state(const Parameters& p, double t, double theta_o0, double dtheta_o0);
 
+/// The same stable evaluators with the parameter combinations (rates, cot φ,
+/// damping) computed once — for evaluating many points of one parameter set.
+class StableSegments {
+ public:
+  explicit StableSegments(const Parameters& p);
+  const Parameters& parameters() const { return p_; }
+  double cot_phi() const { return cot_; }
+  FreeState free_state(double t, double dtheta_m0) const;
+  ContactState contact_state(double t, double theta_o0, double dtheta_o0) const;
+
+ private:
+  Parameters p_;
+  bool at_load_;
+  double cot_, a_, b_, k_, a_minus_b_, gap_factor_;  // output at load
+  double alpha_m_, w2_m_;                           // output at motor
+  double alpha_c_, w2_c_;                           // contact
+};
+
 /// A parameter set lying exactly on a branch (used by validation and tests).
 struct BranchRepresentative {
   Branch branch;

@@ -13,13 +13,16 @@
 //   A_n(x, y)   = exp[0^n, x, y]               = (φ_n(x) − φ_n(y))/(x − y)
 //
 // evaluated without cancellation:
-//   φ_n:  |x| < 1 → the Taylor series (Horner, 20 terms);
+//   φ_n:  |x| < 1 → the Taylor series (Horner, 8–19 terms by |x|);
 //         else     → φ_1 = expm1(x)/x and the recurrence φ_{n+1} = (φ_n − 1/n!)/x
 //                    (cancellation bounded by a factor e for |x| ≥ 1).
-//   A_n:  max(|x|,|y|) ≤ 1        → Σ_j h_j(x,y)/(j+n+1)!, h_j the complete
-//                                   homogeneous polynomial (24 terms);
+//         (load_kernels, the hot path, switches at |x| = 1/8 for φ1, φ2: one
+//         series below, expm1 and one division above — a factor ≤ 16 lost.)
+//   A_n:  max(|x|,|y|) ≤ 1/4, or ≤ 1 with close nodes
+//                                 → Σ_j h_j(x,y)/(j+n+1)!, h_j the complete
+//                                   homogeneous polynomial (7–23 terms by size);
 //         |x − y| ≥ max(|x|,|y|)/4 → the difference quotient of φ_n (loses at most
-//                                   a few bits: the nodes are well separated);
+//                                   ~100 ulp: the nodes are well separated);
 //         otherwise (close nodes, away from 0) → A_0 = e^m·sinh(h)/h with
 //                                   m = (x+y)/2, h = (x−y)/2 (series for small h),
 //                                   then A_n = (A_{n−1} − φ_n(x))/y, which is
@@ -41,6 +44,12 @@ double phi(int n, double x);
 
 /// exp[0^n, x, y]: the divided difference of exp over n zeros and x, y; n = 0…3.
 double exp_divided_difference(int n, double x, double y);
+
+/// e^x and φ1(x) with one libm call.
+struct ExpPhi1 {
+  double exp_x, phi1_x;
+};
+ExpPhi1 exp_phi1(double x);
 
 /// Everything the output-at-load free mode needs at x = −a·t, y = −b·t, computed
 /// together (two expm1 calls in the generic case): e^x, φ1(x), φ2(x), e^y,

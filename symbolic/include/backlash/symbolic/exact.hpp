@@ -47,8 +47,9 @@ GiNaC::ex simplify(const GiNaC::ex& expression, const RadicalList& radicals);
 /// (Only a genuine zero returns true; radicals are treated as independent.)
 bool is_exactly_zero(const GiNaC::ex& expression, const RadicalList& radicals);
 
-/// sqrt of a non-negative rational in canonical form a/q·sqrt(r), r square-free
-/// integer (so sqrt(113/75) prints as 1/15*sqrt(339)); a symbolic square
+/// sqrt of a non-negative rational in canonical form a/q·sqrt(r) (so sqrt(113/75)
+/// prints as 1/15*sqrt(339)); r is free of square factors below 2^16 and is not a
+/// perfect square, so a rational root is always recognised; a symbolic square
 /// gives sqrt(square).
 GiNaC::ex canonical_sqrt(const GiNaC::ex& square);
 
