@@ -246,12 +246,18 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
       // Tc = (JL K/J)(θR − θo) + (FL − JL F/J) θ̇o without the cancellation θR − θo: by
       // linearity θo − θR = (θo0 − θR)·a(τ) + θ̇o0·b(τ) with the unit responses a, b of the
       // validated closed form, so the rounding error scales with the motion, not with θR.
-      w.value = [&evaluator, &p, &torque, theta0, omega0](double tau) {
+      // Far from a zero of Tc the cancellation is harmless, so the unit responses are only
+      // evaluated where |Tc| is within a few thousand ulps of θR's scale.
+      const double cancellation_scale = 4096 * std::numeric_limits<double>::epsilon() * std::fabs(torque.r(0)) *
+                                        std::max(1.0, std::fabs(p.theta_R));
+      w.value = [&evaluator, &p, &torque, theta0, omega0, cancellation_scale](double tau) {
+        const ContactState c = evaluator.contact_state(tau, theta0, omega0);
+        const double direct = torque.r(0) * (c.theta_o - p.theta_R) + torque.r(1) * c.dtheta_o;
+        if (std::fabs(direct) > cancellation_scale) return direct;
         const double a = evaluator.contact_state(tau, p.theta_R + 1, 0).theta_o - p.theta_R;
         const double b = evaluator.contact_state(tau, p.theta_R, 1).theta_o - p.theta_R;
         const double deviation = (theta0 - p.theta_R) * a + omega0 * b;
-        const double velocity = evaluator.contact_state(tau, theta0, omega0).dtheta_o;
-        return torque.r(0) * deviation + torque.r(1) * velocity;
+        return torque.r(0) * deviation + torque.r(1) * c.dtheta_o;
       };
       const int face = state.face;
       auto at = [&evaluator, &p, theta0, omega0, face](double tau) {
