@@ -38,6 +38,18 @@ LinearWitness gap_witness(const ValidatedEvaluator& evaluator, double dtheta_m0,
       [&evaluator, dtheta_m0](double t) { return evaluator.free_state(t, dtheta_m0).gap; }, level);
 }
 
+// The states at the impact time point.t: motor and load before it, the recombined system after (eq. 24).
+void fill_impact_states(const ValidatedEvaluator& evaluator, DividingLinePoint& point) {
+  const Parameters& p = evaluator.parameters();
+  const FreeState f = evaluator.free_state(point.t, point.dtheta_m0);
+  point.theta_m = f.theta_m;
+  point.dtheta_m = f.dtheta_m;
+  point.theta_L = f.theta_L;
+  point.dtheta_L = f.dtheta_L;
+  point.theta_o = p.measured_at == model::MeasuredAt::Motor ? f.theta_m : f.theta_L;
+  point.dtheta_o = recombined_velocity(p, f.dtheta_m, f.dtheta_L);
+}
+
 // Start of the search for a return to the face left.  On the separation line
 // the gap starts as w'''(0) t^3/6 (value, slope and curvature vanish), far below
 // rounding noise at first; the search starts at a certified departure time t0:
@@ -64,13 +76,7 @@ DividingLinePoint dividing_line_point(const ValidatedEvaluator& evaluator, doubl
                                                                : RecombinationStatus::Recombination;
   point.t = event->crossing.t;
   point.grazing = event->crossing.grazing;
-  const FreeState f = evaluator.free_state(point.t, v0);
-  point.theta_m = f.theta_m;
-  point.dtheta_m = f.dtheta_m;
-  point.theta_L = f.theta_L;
-  point.dtheta_L = f.dtheta_L;
-  point.theta_o = p.measured_at == model::MeasuredAt::Motor ? f.theta_m : f.theta_L;
-  point.dtheta_o = recombined_velocity(p, f.dtheta_m, f.dtheta_L);
+  fill_impact_states(evaluator, point);
   return point;
 }
 
@@ -152,13 +158,7 @@ DividingLinePoint point_from_profile(const ValidatedEvaluator& evaluator, const 
   } else {
     return point;
   }
-  const FreeState f = evaluator.free_state(point.t, v0);
-  point.theta_m = f.theta_m;
-  point.dtheta_m = f.dtheta_m;
-  point.theta_L = f.theta_L;
-  point.dtheta_L = f.dtheta_L;
-  point.theta_o = p.measured_at == model::MeasuredAt::Motor ? f.theta_m : f.theta_L;
-  point.dtheta_o = recombined_velocity(p, f.dtheta_m, f.dtheta_L);
+  fill_impact_states(evaluator, point);
   return point;
 }
 
