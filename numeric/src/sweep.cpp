@@ -40,7 +40,7 @@ std::vector<SweepPoint> figure31_points(int n) {
 
 std::vector<SweepPoint> figure32_points(int n) {
   struct Distribution { const char* name; double Fm, FL; };
-  const Distribution distributions[] = {{"FL=0,Fm=.2", 0.2, 0.0}, {"Fm=3FL,F=.4", 0.3, 0.1}, {"FL=3Fm,F=.4", 0.1, 0.3}};
+  const Distribution distributions[] = {{"FL=0 Fm=.2", 0.2, 0.0}, {"Fm=3FL F=.4", 0.3, 0.1}, {"FL=3Fm F=.4", 0.1, 0.3}};
   std::vector<SweepPoint> points;
   for (const Distribution& d : distributions) {
     for (int i = 0; i < n; ++i) {

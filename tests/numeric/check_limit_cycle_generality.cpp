@@ -120,3 +120,12 @@ TEST(HybridSimulationGenerality, EventTimesDoNotDependOnTheReference) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(SweepFigure32, SeriesNamesAreCsvSafe) {
+  for (const SweepPoint& p : figure32_points(2)) EXPECT_EQ(p.series.find(','), std::string::npos) << p.series;
+  for (const SweepPoint& p : figure31_points(2)) EXPECT_EQ(p.series.find(','), std::string::npos) << p.series;
+}
+
+}  // namespace
