@@ -40,6 +40,10 @@ double measured(const Parameters& p, const HybridState& s) {
   return p.measured_at == model::MeasuredAt::Motor ? s.theta_m : s.theta_L;
 }
 
+double measured_velocity(const Parameters& p, const HybridState& s) {
+  return p.measured_at == model::MeasuredAt::Motor ? s.dtheta_m : s.dtheta_L;
+}
+
 namespace {
 
 HybridState contact_state_on_face(const Parameters& p, int face, double theta_o, double velocity) {
@@ -150,26 +154,6 @@ void segment_extremes(const Parameters& p, const LinearSegment& segment, const s
   }
 }
 
-class Recorder {
- public:
-  Recorder(const Parameters& p, const SimulationOptions& o, SimulationResult& r) : p_(p), o_(o), r_(r) {}
-  // Samples of a segment on [t0, t1] (segment time τ = t − t0).
-  void segment(double t0, double t1, const std::function<HybridState(double)>& at) {
-    if (o_.sample_interval <= 0) return;
-    while (next_ <= t1 + 1e-12) {
-      const HybridState h = at(next_ - t0);
-      r_.samples.push_back({next_, measured(p_, h), p_.measured_at == model::MeasuredAt::Motor ? h.dtheta_m : h.dtheta_L,
-                            h.theta_m, h.dtheta_m, h.theta_L, h.dtheta_L, h.in_contact});
-      next_ += o_.sample_interval;
-    }
-  }
-
- private:
-  const Parameters& p_;
-  const SimulationOptions& o_;
-  SimulationResult& r_;
-  double next_ = 0;
-};
 
 }  // namespace
 
@@ -198,7 +182,7 @@ HybridState step_start(const Parameters& p, double step) {
 SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options) {
   const Parameters& p = evaluator.parameters();
   SimulationResult result;
-  Recorder recorder(p, options, result);
+  TrajectoryRecorder recorder(p, options, result);
   const LinearSegment contact_segment = contact_mode_segment(p);
   const LinearSegment free_segment = free_mode_segment(p);
   const TransmittedTorque torque = transmitted_torque(p);
@@ -218,7 +202,7 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
     e.t = t;
     e.kind = kind;
     e.theta_o = measured(p, state);
-    e.dtheta_o = p.measured_at == model::MeasuredAt::Motor ? state.dtheta_m : state.dtheta_L;
+    e.dtheta_o = measured_velocity(p, state);
     e.after = state;
     e.bounce = bounce;
     e.grazing = grazing;
@@ -296,12 +280,12 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
       if (options.track_extremes)
         segment_extremes(p, contact_segment, contact_vector, at, separation ? separation->t : remaining, true, result.extremes);
       if (!separation) {
-        recorder.segment(t, options.t_end, at);
+        recorder.record(t, options.t_end + 1e-12, at);
         state = at(remaining);
         t = options.t_end;
         return finish(SimulationStatus::Completed);
       }
-      recorder.segment(t, t + separation->t, at);
+      recorder.record(t, t + separation->t + 1e-12, at);
       const HybridState at_separation = at(separation->t);
       t += separation->t;
       state = at_separation;
@@ -323,7 +307,7 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
     if (options.track_extremes)
       segment_extremes(p, free_segment, flight.vector, flight.at, event ? event->crossing.t : remaining, false, result.extremes);
     if (!event) {
-      recorder.segment(t, options.t_end, flight.at);
+      recorder.record(t, options.t_end + 1e-12, flight.at);
       const HybridState end = flight.at(remaining);
       const double speed = std::max(std::fabs(end.dtheta_m), std::fabs(end.dtheta_L));
       if (speed < options.rest_velocity) {
@@ -350,7 +334,7 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
       t = options.t_end;
       return finish(SimulationStatus::Completed);
     }
-    recorder.segment(t, t + event->crossing.t, flight.at);
+    recorder.record(t, t + event->crossing.t + 1e-12, flight.at);
     HybridState before = flight.at(event->crossing.t);
     t += event->crossing.t;
     // Inelastic impact (eq. 24) on the face hit.

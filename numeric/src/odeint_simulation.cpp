@@ -178,27 +178,6 @@ inline double sample_time(double t_old, double t_new, int k, int n) {
   return k == n ? t_new : t_old + (t_new - t_old) * k / n;
 }
 
-class Recorder {
- public:
-  Recorder(const Parameters& p, const SimulationOptions& o, SimulationResult& r) : p_(p), o_(o), r_(r) {}
-  // Samples at global times ≤ t_upto on a segment starting at t0 (segment time τ = t − t0).
-  template <class At>
-  void upto(double t0, double t_upto, const At& at) {
-    if (o_.sample_interval <= 0) return;
-    while (next_ <= t_upto) {
-      const HybridState h = at(next_ - t0);
-      r_.samples.push_back({next_, measured(p_, h), p_.measured_at == model::MeasuredAt::Motor ? h.dtheta_m : h.dtheta_L,
-                            h.theta_m, h.dtheta_m, h.theta_L, h.dtheta_L, h.in_contact});
-      next_ += o_.sample_interval;
-    }
-  }
-
- private:
-  const Parameters& p_;
-  const SimulationOptions& o_;
-  SimulationResult& r_;
-  double next_ = 0;
-};
 
 }  // namespace
 
@@ -212,7 +191,7 @@ double fastest_rate(const Parameters& p) {
 SimulationResult simulate_with_odeint(const Parameters& p, const HybridState& start, const SimulationOptions& options,
                                       const OdeintSimulationOptions& oo) {
   SimulationResult result;
-  Recorder recorder(p, options, result);
+  TrajectoryRecorder recorder(p, options, result);
   const ContactSystem contact_system{p};
   const double dt_max = oo.max_step_fraction / fastest_rate(p);
   // Witness samples: at most dt_max / (interior_checks + 1) apart on every step (a step of
@@ -293,7 +272,7 @@ SimulationResult simulate_with_odeint(const Parameters& p, const HybridState& st
               return z;
             };
             auto samples_upto = [&](double upto) {
-              recorder.upto(t0, upto, [&](double tau) { return at_vec(at_tau(tau)); });
+              recorder.record(t0, upto, [&](double tau) { return at_vec(at_tau(tau)); });
             };
             double s_prev = ta;
             const int n = samples_in(ta, tb);
@@ -337,7 +316,7 @@ SimulationResult simulate_with_odeint(const Parameters& p, const HybridState& st
           t = options.t_end;
           return finish(SimulationStatus::Completed);
         }
-        if (*separation == 0) recorder.upto(t0, t0 + 1e-12, [&](double) { return at_vec(y0); });
+        if (*separation == 0) recorder.record(t0, t0 + 1e-12, [&](double) { return at_vec(y0); });
         t += *separation;
         state = at_vec(y_end);
         state.in_contact = false;  // face σ is now the face just left
@@ -385,7 +364,7 @@ SimulationResult simulate_with_odeint(const Parameters& p, const HybridState& st
           return z;
         };
         auto samples_upto = [&](double upto) {
-          recorder.upto(t0, upto, [&](double tau) { return frame.at(at_tau(tau)); });
+          recorder.record(t0, upto, [&](double tau) { return frame.at(at_tau(tau)); });
         };
         double s_prev = ta;
         const int n = samples_in(ta, tb);

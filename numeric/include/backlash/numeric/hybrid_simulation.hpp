@@ -86,8 +86,33 @@ struct SimulationResult {
   Extremes extremes;  ///< when options.track_extremes
 };
 
-/// The measured shaft of a state.
+/// The measured shaft of a state, and its velocity.
 double measured(const Parameters& p, const HybridState& s);
+double measured_velocity(const Parameters& p, const HybridState& s);
+
+/// Records the trajectory every `options.sample_interval` (for CSV output); shared by the
+/// closed-form and the odeint simulators (bookkeeping only, no dynamics).
+class TrajectoryRecorder {
+ public:
+  TrajectoryRecorder(const Parameters& p, const SimulationOptions& o, SimulationResult& r) : p_(p), o_(o), r_(r) {}
+  /// Samples at the global times ≤ t_upto of a segment that starts at t0; `at(τ)` is its state at τ = t − t0.
+  template <class At>
+  void record(double t0, double t_upto, const At& at) {
+    if (o_.sample_interval <= 0) return;
+    while (next_ <= t_upto) {
+      const HybridState h = at(next_ - t0);
+      r_.samples.push_back({next_, measured(p_, h), measured_velocity(p_, h), h.theta_m, h.dtheta_m, h.theta_L,
+                            h.dtheta_L, h.in_contact});
+      next_ += o_.sample_interval;
+    }
+  }
+
+ private:
+  const Parameters& p_;
+  const SimulationOptions& o_;
+  SimulationResult& r_;
+  double next_ = 0;
+};
 
 /// The state with the measured shaft at θo, both shafts moving at `velocity`, and the
 /// gap at the face σ (x = σ b/2): in contact on it, or just leaving it.
