@@ -27,5 +27,6 @@ void register_trace_command(CLI::App& app);    // cli/trace_command.cpp
 void register_simulate_command(CLI::App& app); // cli/simulate_command.cpp
 void register_limit_cycle_command(CLI::App& app);  // cli/limit_cycle_command.cpp
 void register_sweep_command(CLI::App& app);    // cli/sweep_command.cpp
+void register_import_command(CLI::App& app);   // cli/import_command.cpp
 
 }  // namespace backlash::cli

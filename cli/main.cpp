@@ -47,6 +47,7 @@ int main(int argument_count, char** arguments) {
   backlash::cli::register_simulate_command(app);
   backlash::cli::register_limit_cycle_command(app);
   backlash::cli::register_sweep_command(app);
+  backlash::cli::register_import_command(app);
 
   try {
     app.parse(argument_count, arguments);

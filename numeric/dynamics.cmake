@@ -10,6 +10,10 @@ target_sources(backlash_numeric PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/src/limit_cycle.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/validated_family.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/sweep.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/src/odeint_simulation.cpp)   # odeint: the independent cross-check simulator
+  ${CMAKE_CURRENT_LIST_DIR}/src/odeint_simulation.cpp    # odeint: the independent cross-check simulator
+  # Effects the thesis left out (docs/effects.md)
+  ${CMAKE_CURRENT_LIST_DIR}/src/effects.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/effects_simulation.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/odeint_effects_simulation.cpp)  # odeint: the independent simulator with effects
 find_package(Threads REQUIRED)
 target_link_libraries(backlash_numeric PUBLIC Threads::Threads)

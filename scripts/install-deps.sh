@@ -10,8 +10,10 @@ required_packages=(
   libeigen3-dev libboost-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libfmt-dev
-  gnuplot-nox
-  python3-sympy python3-scipy python3-numpy
+  gnuplot-nox librsvg2-bin
+  libceres-dev libmatio-dev
+  texlive-latex-base texlive-latex-recommended texlive-fonts-recommended poppler-utils
+  python3-sympy python3-scipy python3-numpy python3-pytest pybind11-dev
 )
 
 missing_packages=()

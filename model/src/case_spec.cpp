@@ -253,7 +253,7 @@ class CaseFileReader {
     spec.id = file_.stem().string();
 
     reject_unknown_keys(root, "",
-                        {"name", "measured_at", "K", "backlash", "reference", "motor", "load", "experiment"});
+                        {"name", "measured_at", "K", "backlash", "reference", "motor", "load", "experiment", "effects"});
     const long top_line = 1;
     spec.name = read_name(require(root, "", top_line, "name"));
     spec.measured_at = read_measured_at(require(root, "", top_line, "measured_at"));
@@ -293,6 +293,7 @@ class CaseFileReader {
       }
       spec.experiment = parsed;
     }
+    if (const toml::node* effects_node = root.get("effects")) spec.effects = read_effects(*effects_node, top_line);
     return spec;
   }
 
@@ -364,6 +365,62 @@ class CaseFileReader {
 
     inertia = inertia_number.value;
     friction = friction_number.value;
+  }
+
+  /// A number of the [effects] table that must satisfy `valid`, else `problem` (the value is appended).
+  template <class Valid>
+  Rational read_effect_number(const toml::node& node, const std::string& key, Valid valid,
+                              const std::string& problem) const {
+    const ExactNumber number = read_number(node, key);
+    if (!valid(number.value)) fail(line_of(node, 1), key, problem + " (got " + number.as_written + ")");
+    return number.value;
+  }
+
+  /// [effects] (docs/effects.md): every entry optional, exact, checked.
+  Effects read_effects(const toml::node& node, long fallback_line) const {
+    const toml::table& table = require_table(node, "effects");
+    const long header_line = line_of(table, fallback_line);
+    reject_unknown_keys(table, "effects",
+                        {"coulomb_motor", "coulomb_load", "restitution", "saturation", "compliance", "delay",
+                         "torque_offset"});
+    Effects effects;
+    const auto non_negative = [](const Rational& value) { return value >= 0; };
+    const auto positive = [](const Rational& value) { return value > 0; };
+    if (const toml::node* entry = table.get("coulomb_motor"))
+      effects.coulomb_motor = read_effect_number(*entry, "effects.coulomb_motor", non_negative,
+                                                 "negative Coulomb torque; a friction torque must be >= 0");
+    if (const toml::node* entry = table.get("coulomb_load"))
+      effects.coulomb_load = read_effect_number(*entry, "effects.coulomb_load", non_negative,
+                                                "negative Coulomb torque; a friction torque must be >= 0");
+    if (const toml::node* entry = table.get("restitution"))
+      effects.restitution = read_effect_number(
+          *entry, "effects.restitution", [](const Rational& e) { return e >= 0 && e < 1; },
+          "coefficient of restitution outside [0, 1): 0 is the inelastic impact, 1 would never settle");
+    if (const toml::node* entry = table.get("saturation"))
+      effects.saturation = read_effect_number(*entry, "effects.saturation", positive,
+                                              "non-positive saturation limit; the drive torque limit must be > 0");
+    if (const toml::node* entry = table.get("delay"))
+      effects.delay = read_effect_number(*entry, "effects.delay", non_negative, "negative delay; tau must be >= 0");
+    if (const toml::node* entry = table.get("torque_offset"))
+      effects.torque_offset = read_number(*entry, "effects.torque_offset").value;
+    if (const toml::node* entry = table.get("compliance")) {
+      const toml::table& mesh = require_table(*entry, "effects.compliance");
+      const long mesh_line = line_of(mesh, header_line);
+      reject_unknown_keys(mesh, "effects.compliance", {"stiffness", "damping"});
+      Compliance compliance;
+      compliance.stiffness =
+          read_effect_number(require(mesh, "effects.compliance", mesh_line, "stiffness"), "effects.compliance.stiffness",
+                             positive, "non-positive mesh stiffness; a spring must be > 0 (omit the effect for a rigid mesh)");
+      compliance.damping =
+          read_effect_number(require(mesh, "effects.compliance", mesh_line, "damping"), "effects.compliance.damping",
+                             non_negative, "negative mesh damping; it must be >= 0");
+      effects.compliance = compliance;
+      if (effects.restitution != 0)
+        fail(line_of(*table.get("restitution"), header_line), "effects.restitution",
+             "restitution and compliance both model the impact (a compliant mesh has its own rebound, set by its "
+             "damping); give one of them");
+    }
+    return effects;
   }
 
   std::string read_name(const toml::node& node) const {

@@ -21,6 +21,20 @@ const char* to_string(EventKind kind) {
     case EventKind::Recombination: return "recombination";
     case EventKind::Recontact: return "recontact";
     case EventKind::Rest: return "rest";
+    case EventKind::Stick: return "stick";
+    case EventKind::Slip: return "slip";
+    case EventKind::Saturation: return "saturation";
+    case EventKind::Desaturation: return "desaturation";
+  }
+  return "?";
+}
+
+const char* to_string(Body body) {
+  switch (body) {
+    case Body::None: return "none";
+    case Body::Motor: return "motor";
+    case Body::Load: return "load";
+    case Body::Both: return "both";
   }
   return "?";
 }

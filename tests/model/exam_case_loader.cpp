@@ -217,19 +217,105 @@ TEST_F(CaseFileVariants, TheValidFileLoads) {
   expect_exact(spec.experiment->step, exact(31, 50), "experiment.step");
 }
 
+// ------------------------------------------------------------------ [effects] (docs/effects.md)
+
+/// The valid file followed by an [effects] table made of `entries` (its header is line 18).
+std::vector<std::string> with_effects(const std::vector<std::string>& entries) {
+  std::vector<std::string> lines = valid_case_lines;
+  lines.push_back("[effects]");  // 18
+  lines.insert(lines.end(), entries.begin(), entries.end());
+  return lines;
+}
+
+TEST_F(CaseFileVariants, NoEffectsTableIsTheNominalModel) {
+  const CaseSpec spec = load(valid_case_lines);
+  EXPECT_FALSE(spec.effects.any());
+  EXPECT_FALSE(spec.effects.saturation.has_value());
+  EXPECT_FALSE(spec.effects.compliance.has_value());
+}
+
+TEST_F(CaseFileVariants, EffectsAreReadExactly) {
+  const CaseSpec spec = load(with_effects({"coulomb_motor = 0.05", "coulomb_load = \"3/100\"", "restitution = 0.4",
+                                           "saturation = 0.5", "delay = 0.05", "torque_offset = -0.02"}));
+  expect_exact(spec.effects.coulomb_motor, exact(1, 20), "effects.coulomb_motor");
+  expect_exact(spec.effects.coulomb_load, exact(3, 100), "effects.coulomb_load");
+  expect_exact(spec.effects.restitution, exact(2, 5), "effects.restitution");
+  ASSERT_TRUE(spec.effects.saturation.has_value());
+  expect_exact(*spec.effects.saturation, exact(1, 2), "effects.saturation");
+  expect_exact(spec.effects.delay, exact(1, 20), "effects.delay");
+  expect_exact(spec.effects.torque_offset, exact(-1, 50), "effects.torque_offset");
+  EXPECT_TRUE(spec.effects.any());
+}
+
+TEST_F(CaseFileVariants, ComplianceAsInlineOrStandardTable) {
+  const CaseSpec inline_table = load(with_effects({"compliance = { stiffness = 400, damping = 4.5 }"}));
+  ASSERT_TRUE(inline_table.effects.compliance.has_value());
+  expect_exact(inline_table.effects.compliance->stiffness, exact(400), "stiffness");
+  expect_exact(inline_table.effects.compliance->damping, exact(9, 2), "damping");
+  std::vector<std::string> lines = valid_case_lines;
+  lines.insert(lines.end(), {"[effects.compliance]", "stiffness = 1e4", "damping = 0"});
+  const CaseSpec standard = load(lines);
+  ASSERT_TRUE(standard.effects.compliance.has_value());
+  expect_exact(standard.effects.compliance->stiffness, exact(10000), "stiffness");
+}
+
+TEST_F(CaseFileVariants, NeutralValuesAreTheNominalModel) {
+  const CaseSpec spec = load(with_effects({"coulomb_motor = 0", "coulomb_load = 0", "restitution = 0", "delay = 0",
+                                           "torque_offset = 0"}));
+  EXPECT_FALSE(spec.effects.any());
+}
+
+TEST_F(CaseFileVariants, BadEffectValuesNameLineAndKey) {
+  expect_rejected(with_effects({"coulomb_motor = -0.05"}), 19, "effects.coulomb_motor",
+                  "negative Coulomb torque; a friction torque must be >= 0 (got -0.05)");
+  expect_rejected(with_effects({"delay = 0", "coulomb_load = -1"}), 20, "effects.coulomb_load",
+                  "negative Coulomb torque; a friction torque must be >= 0 (got -1)");
+  expect_rejected(with_effects({"restitution = 1"}), 19, "effects.restitution",
+                  "coefficient of restitution outside [0, 1): 0 is the inelastic impact, 1 would never settle (got 1)");
+  expect_rejected(with_effects({"restitution = -0.1"}), 19, "effects.restitution",
+                  "coefficient of restitution outside [0, 1): 0 is the inelastic impact, 1 would never settle (got -0.1)");
+  expect_rejected(with_effects({"saturation = 0"}), 19, "effects.saturation",
+                  "non-positive saturation limit; the drive torque limit must be > 0 (got 0)");
+  expect_rejected(with_effects({"delay = -0.01"}), 19, "effects.delay", "negative delay; tau must be >= 0 (got -0.01)");
+  expect_rejected(with_effects({"compliance = { stiffness = 0, damping = 1 }"}), 19, "effects.compliance.stiffness",
+                  "non-positive mesh stiffness; a spring must be > 0 (omit the effect for a rigid mesh) (got 0)");
+  expect_rejected(with_effects({"compliance = { stiffness = 10, damping = -1 }"}), 19, "effects.compliance.damping",
+                  "negative mesh damping; it must be >= 0 (got -1)");
+  expect_rejected(with_effects({"compliance = { stiffness = 10 }"}), 19, "effects.compliance.damping", "missing key");
+  expect_rejected(with_effects({"compliance = 3"}), 19, "effects.compliance",
+                  "expected a table [effects.compliance], got an integer");
+  expect_rejected(with_effects({"saturation = \"inf\""}), 19, "effects.saturation", "non-finite number (got \"inf\")");
+  expect_rejected(with_effects({"coulomb_motor = true"}), 19, "effects.coulomb_motor", "expected a number, got a boolean");
+}
+
+TEST_F(CaseFileVariants, UnknownEffectIsRefusedWithTheVocabulary) {
+  expect_rejected(with_effects({"coulomb_load = 0.1", "stiction = 0.2"}), 20, "effects.stiction",
+                  "unknown key (allowed: coulomb_motor, coulomb_load, restitution, saturation, compliance, delay, "
+                  "torque_offset)");
+  expect_rejected(with_effects({"compliance = { stiffness = 10, damping = 1, mass = 2 }"}), 19,
+                  "effects.compliance.mass", "unknown key (allowed: stiffness, damping)");
+}
+
+TEST_F(CaseFileVariants, RestitutionWithComplianceIsRefused) {
+  expect_rejected(with_effects({"restitution = 0.3", "compliance = { stiffness = 400, damping = 4 }"}), 19,
+                  "effects.restitution",
+                  "restitution and compliance both model the impact (a compliant mesh has its own rebound, set by its "
+                  "damping); give one of them");
+}
+
 TEST_F(CaseFileVariants, UnknownKeyInATable) {
   expect_rejected(with_inserted_line(10, "G = 2"), 10, "motor.G", "unknown key (allowed: J, F)");
 }
 
 TEST_F(CaseFileVariants, UnknownTopLevelKey) {
   expect_rejected(with_inserted_line(4, "gain = 2"), 4, "gain",
-                  "unknown key (allowed: name, measured_at, K, backlash, reference, motor, load, experiment)");
+                  "unknown key (allowed: name, measured_at, K, backlash, reference, motor, load, experiment, effects)");
 }
 
 TEST_F(CaseFileVariants, UnknownKeyDifferingOnlyInCaseGetsAHint) {
   expect_rejected(with_line(3, "k = 1"), 3, "k",
                   "unknown key (did you mean 'K'? allowed: name, measured_at, K, backlash, reference, motor, load, "
-                  "experiment)");
+                  "experiment, effects)");
 }
 
 TEST_F(CaseFileVariants, UnknownTable) {
@@ -237,7 +323,7 @@ TEST_F(CaseFileVariants, UnknownTable) {
   lines.push_back("[gearbox]");
   lines.push_back("ratio = 2");
   expect_rejected(lines, 18, "gearbox",
-                  "unknown key (allowed: name, measured_at, K, backlash, reference, motor, load, experiment)");
+                  "unknown key (allowed: name, measured_at, K, backlash, reference, motor, load, experiment, effects)");
 }
 
 TEST_F(CaseFileVariants, MissingKeyInATableNamesTheTableHeaderLine) {

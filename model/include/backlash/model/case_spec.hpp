@@ -32,6 +32,32 @@ struct Experiment {
   std::optional<Rational> t_end;
 };
 
+/// The gear mesh as a spring-damper beyond the backlash (docs/effects.md §compliance):
+/// it pushes with stiffness·δ + damping·δ̇ (δ the penetration beyond a face), never pulls.
+struct Compliance {
+  Rational stiffness;  ///< torque per radian of penetration, > 0
+  Rational damping;    ///< torque per rad/s, >= 0
+};
+
+/// The effects the thesis left out (docs/effects.md), as read from the optional
+/// [effects] table.  An absent entry is the effect at its neutral value: no
+/// Coulomb torque, the inelastic impact (e = 0), an unlimited drive, a rigid
+/// mesh, no delay, no offset.
+struct Effects {
+  Rational coulomb_motor;              ///< Coulomb torque on the motor, >= 0 (with sticking)
+  Rational coulomb_load;               ///< Coulomb torque on the load, >= 0 (with sticking)
+  Rational restitution;                ///< Newton's coefficient e, 0 <= e < 1
+  std::optional<Rational> saturation;  ///< drive torque K(θR − θo) clipped at ±limit, limit > 0
+  std::optional<Compliance> compliance;
+  Rational delay;                      ///< τ >= 0 [s]: the fed-back angle is θo(t − τ)
+  Rational torque_offset;              ///< a constant torque on the motor shaft (any sign)
+  /// True when some effect differs from its neutral value.
+  bool any() const {
+    return coulomb_motor != 0 || coulomb_load != 0 || restitution != 0 || saturation || compliance || delay != 0 ||
+           torque_offset != 0;
+  }
+};
+
 struct CaseSpec {
   std::string id;            ///< "I".."VIII" for thesis cases, else the file stem
   std::string name;          ///< the file's `name`
@@ -43,6 +69,7 @@ struct CaseSpec {
   Rational Jm, Fm;           ///< motor-side inertia and viscous friction
   Rational JL, FL;           ///< load inertia and viscous friction
   std::optional<Experiment> experiment;
+  Effects effects;           ///< the [effects] table (all neutral when absent)
 };
 
 /// A bad case file. what() is one line: "FILE:LINE: KEY: problem".
@@ -61,6 +88,9 @@ class CaseFileError : public std::runtime_error {
 
 /// Strict loader: unknown or missing keys, non-positive inertia, negative
 /// friction/backlash/gain, non-finite or non-numeric values → CaseFileError.
+/// [effects]: negative Coulomb torque, e outside [0, 1), a limit <= 0, a
+/// stiffness <= 0, a negative damping or delay, an unknown effect, and the pair
+/// restitution + compliance (both would model the impact) → CaseFileError.
 /// Decimals as written become exact rationals (0.3 → 3/10); strings "p/q" and
 /// integers are accepted.
 CaseSpec load_case_file(const std::filesystem::path& file);

@@ -31,13 +31,23 @@
 
 namespace backlash::numeric {
 
-enum class EventKind { Separation, Recombination, Recontact, Rest };
+/// Events.  The nominal model has the first four; the effects (effects.hpp,
+/// docs/effects.md) add sticking and breaking away (Coulomb friction) and the drive
+/// entering or leaving its limit (saturation).
+enum class EventKind { Separation, Recombination, Recontact, Rest, Stick, Slip, Saturation, Desaturation };
 const char* to_string(EventKind kind);
+
+/// Which body a stick/slip event concerns.
+enum class Body { None, Motor, Load, Both };
+const char* to_string(Body body);
 
 struct HybridState {
   double theta_m = 0, dtheta_m = 0, theta_L = 0, dtheta_L = 0;
-  bool in_contact = true;
+  bool in_contact = true;  ///< rigid contact, or (compliance) the mesh engaged
   int face = -1;  ///< σ: contact face x = σ b/2 (contact), or the face last left (free)
+  // Effects only (the nominal simulators leave them at their defaults):
+  bool motor_stuck = false, load_stuck = false;  ///< Coulomb sticking (a stuck pair in contact: both)
+  int drive_regime = 0;  ///< saturation: 0 linear, +1 clipped at +L, −1 clipped at −L
 };
 
 struct SimulationEvent {
@@ -47,6 +57,8 @@ struct SimulationEvent {
   HybridState after;
   bool bounce = false;               ///< impact after which contact did not hold
   bool grazing = false;
+  Body body = Body::None;            ///< stick / slip: which body
+  bool accumulation = false;         ///< the end of a summed series of bounces (restitution)
 };
 
 enum class SimulationStatus { Completed, Rest, Chattering, EventLimit, NonFinite };

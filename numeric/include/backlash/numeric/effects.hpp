@@ -1,0 +1,73 @@
+// backlash/numeric/effects.hpp — the effects the thesis left out, as doubles
+// (semantics: docs/effects.md).
+//
+//   Coulomb friction   Tm, TL ≥ 0 [torque]: −T·sgn(ω) on a moving body; a body at rest
+//                      stays stuck while the torque on it is within ±T
+//   restitution        e ∈ [0, 1): v_rel⁺ = −e·v_rel⁻ at gap closure, momentum conserved
+//   saturation         L > 0 [torque]: the drive K(θR − θo) clipped at ±L
+//   compliance         kc > 0 [torque/rad], cc ≥ 0 [torque·s/rad]: the mesh pushes with
+//                      kc·δ + cc·δ̇ beyond ±b/2, never pulls
+//   delay              τ ≥ 0 [s]: the fed-back angle is θo(t − τ)
+//   torque offset      T0 [torque]: a constant torque on the motor shaft
+// Every effect at its neutral value (0, no limit, a rigid mesh) is the nominal model.
+#pragma once
+
+#include "backlash/model/case_spec.hpp"
+#include "backlash/numeric/hybrid_simulation.hpp"
+#include "backlash/numeric/parametric.hpp"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace backlash::numeric {
+
+struct Effects {
+  double coulomb_motor = 0;  ///< Tm
+  double coulomb_load = 0;   ///< TL
+  double restitution = 0;    ///< e
+  double saturation = std::numeric_limits<double>::infinity();      ///< L (∞: unlimited)
+  double mesh_stiffness = std::numeric_limits<double>::infinity();  ///< kc (∞: rigid mesh)
+  double mesh_damping = 0;   ///< cc
+  double delay = 0;          ///< τ
+  double torque_offset = 0;  ///< T0
+
+  bool saturating() const { return std::isfinite(saturation); }
+  bool compliant() const { return std::isfinite(mesh_stiffness); }
+  bool coulomb() const { return coulomb_motor > 0 || coulomb_load > 0; }
+  bool delayed() const { return delay > 0; }
+  /// True when some effect differs from its neutral value.
+  bool any() const {
+    return coulomb() || restitution != 0 || saturating() || compliant() || delayed() || torque_offset != 0;
+  }
+  /// "coulomb_load=0.03, restitution=0.4" (only the effects present; "none" when nominal).
+  std::string describe() const;
+};
+
+/// The case file's [effects] table as doubles.
+Effects effects_of(const model::CaseSpec& spec);
+
+/// The drive torque D = sat(K·(θR − θo_fed_back)) + T0 and the saturation regime it is in
+/// (0 linear, ±1 clipped at ±L).
+double drive_torque(const Parameters& p, const Effects& e, double theta_o_fed_back);
+int drive_regime(const Parameters& p, const Effects& e, double theta_o_fed_back);
+/// D in a given regime (the regime is part of the mode: at a boundary both sides agree).
+double drive_torque_in_regime(const Parameters& p, const Effects& e, double theta_o_fed_back, int regime);
+
+/// The servo period 2π·sqrt(J/K), the time scale of the accumulation rule.
+double servo_period(const Parameters& p);
+
+/// The step start with effects: at rest, θo = θR − step, in contact (rigid, or the mesh
+/// engaged at zero penetration) on the face that drives toward θR; the drive's regime from
+/// the initial error.  Sticking is not decided here: each simulator applies the static
+/// rules of docs/effects.md to a body at rest that is not marked stuck.
+HybridState effects_step_start(const Parameters& p, const Effects& e, double step);
+
+/// Momentum-conserving impact with restitution e: the velocities just after,
+/// v_rel⁺ = −e·v_rel⁻ (e = 0: the thesis's eq. 24, both at the common velocity).
+struct ImpactVelocities {
+  double dtheta_m, dtheta_L;
+};
+ImpactVelocities impact_velocities(const Parameters& p, double restitution, double dtheta_m, double dtheta_L);
+
+}  // namespace backlash::numeric

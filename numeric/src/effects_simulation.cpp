@@ -1,0 +1,1 @@
+// Placeholder: the closed-form simulator with effects (effects_simulation.hpp) is being written.

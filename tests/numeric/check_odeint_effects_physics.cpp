@@ -1,0 +1,2 @@
+// Placeholder: the physics tests of the odeint simulator with effects are being written.
+#include <gtest/gtest.h>
