@@ -13,7 +13,10 @@ target_sources(backlash_numeric PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/src/odeint_simulation.cpp    # odeint: the independent cross-check simulator
   # Effects the thesis left out (docs/effects.md)
   ${CMAKE_CURRENT_LIST_DIR}/src/effects.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/effect_modes.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/effects_simulation.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/effects_validation.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/effects_delay.cpp      # odeint: the delayed model (method of steps)
   ${CMAKE_CURRENT_LIST_DIR}/src/odeint_effects_simulation.cpp)  # odeint: the independent simulator with effects
 find_package(Threads REQUIRED)
 target_link_libraries(backlash_numeric PUBLIC Threads::Threads)

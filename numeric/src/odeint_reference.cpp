@@ -97,4 +97,40 @@ ContactState reference_contact_state(const Parameters& p, double theta_o0, doubl
   return reference_contact_trajectory(p, theta_o0, dtheta_o0, {t}, tolerance).front();
 }
 
+std::vector<SmallVector> reference_linear_trajectory(const LinearSegment& segment, const SmallVector& z0,
+                                                     const std::vector<double>& times, double tolerance) {
+  using Vector = std::vector<double>;
+  const auto n = segment.A.rows();
+  auto system = [&segment, n](const Vector& z, Vector& dz, double /*t*/) {
+    for (Eigen::Index i = 0; i < n; ++i) {
+      double sum = segment.c(i);
+      for (Eigen::Index j = 0; j < n; ++j) sum += segment.A(i, j) * z[j];
+      dz[i] = sum;
+    }
+  };
+  auto convert = [n](const Vector& z) {
+    SmallVector out(n);
+    for (Eigen::Index i = 0; i < n; ++i) out(i) = z[i];
+    return out;
+  };
+  check_times(times);
+  std::vector<SmallVector> out;
+  if (times.empty()) return out;
+  std::vector<double> grid;
+  const bool prepend = times.front() > 0;
+  if (prepend) grid.push_back(0.0);
+  grid.insert(grid.end(), times.begin(), times.end());
+  Vector x(z0.data(), z0.data() + n);
+  auto stepper = odeint::make_dense_output(tolerance, tolerance, odeint::runge_kutta_dopri5<Vector>());
+  bool skip = prepend;
+  odeint::integrate_times(stepper, system, x, grid.begin(), grid.end(), initial_step(times), [&](const Vector& z, double) {
+    if (skip) {
+      skip = false;
+      return;
+    }
+    out.push_back(convert(z));
+  });
+  return out;
+}
+
 }  // namespace backlash::numeric

@@ -73,6 +73,7 @@ struct SimulationOptions {
   double zeno_window = 1e-6;
   long stop_after_separations = 0;  ///< > 0: stop (status completed) right after this many separations
   bool track_extremes = false;      ///< record the exact extremes of θo, θm, θL (zeros of the velocities)
+  bool general_engine = false;      ///< simulate_effects: run the effects engine even when every effect is neutral
 };
 
 /// Exact extremes over the simulated time: at event states and at the certified

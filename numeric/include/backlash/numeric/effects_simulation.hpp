@@ -1,0 +1,122 @@
+// backlash/numeric/effects_simulation.hpp — the hybrid model with the effects
+// the thesis left out (docs/effects.md), simulated on closed forms.
+//
+// Every mode that stays linear with constant forcing (Coulomb friction with
+// sticking, restitution, saturation, compliance, torque offset) is a closed
+// form (effect_modes.hpp), and every event is the first exit of a witness
+// w = row·z + constant from its valid side (w ≥ 0), found by the certified
+// search of first_crossing.hpp:
+//   rigid contact    −σ·Tc (separation), s·ω (the pair's velocity zero), the drive's limits
+//   free flight      the gap to either face (impacts), s·θ̇ per slipping body (velocity zeros),
+//                    Tm ∓ D for a stuck motor (break-away), the drive's limits
+//   mesh engaged     P = kc δ + cc δ̇ (release), velocity zeros and break-away of each body
+//   free, compliant  −δ to each face (engagement), or −P and δ while the teeth overlap
+// A witness that starts on its boundary (w(0) within rounding) is decided by its first
+// derivative that is not rounding noise: leaving the valid side is an event at once,
+// entering it starts the search after a certified departure time.
+// The static rules (sticking, break-away, the pair's band), the impact law with
+// restitution and the accumulation of a bounce series are those of docs/effects.md.
+// With a delay the model has no closed form: the fed-back angle comes from a
+// history and the segments are integrated with Boost.Odeint (effects_delay.cpp).
+//
+// The closed forms pass a gate first: validate_effects() checks every reachable
+// mode's flow against Boost.Odeint integrating the mode's own z' = A z + c, and
+// only then hands out a ValidatedEffectModel.  Without effects the nominal
+// simulator (hybrid_simulation.hpp) runs, on the validated nominal evaluator.
+#pragma once
+
+#include "backlash/numeric/effect_modes.hpp"
+#include "backlash/numeric/effects.hpp"
+#include "backlash/numeric/hybrid_simulation.hpp"
+#include "backlash/numeric/validation.hpp"
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace backlash::numeric {
+
+struct EffectValidationOptions {
+  double tolerance = 1e-9;          ///< max abs error of every local coordinate
+  double odeint_tolerance = 1e-12;  ///< abs = rel tolerance of the reference
+  int time_points = 120;            ///< samples per trajectory
+  double time_constants = 6;        ///< horizon in units of the slowest time scale
+  double max_horizon = 30;          ///< cap on the horizon [s]
+};
+
+struct ModeValidation {
+  Mode mode;
+  double max_abs_error = 0;
+  double at_tau = 0;
+  int trajectories = 0;
+  bool matrix_exponential = false;  ///< the generic flow fell back to the Padé exponential
+  bool passed = false;
+};
+
+struct EffectValidationReport {
+  Effects effects;
+  double tolerance = 0;
+  std::vector<ModeValidation> modes;
+  bool passed = false;
+  /// One line per mode: "free (left face -1) motor + load stuck  max |error| 3e-14 at τ = 2.1  pass".
+  std::string summary() const;
+};
+
+class EffectValidationResult;
+
+/// A model with effects whose nominal evaluator and effect-mode flows passed their gates.
+class ValidatedEffectModel {
+ public:
+  const Parameters& parameters() const { return nominal_.parameters(); }
+  const Effects& effects() const { return effects_; }
+  const ValidatedEvaluator& nominal() const { return nominal_; }
+  const EffectValidationReport& report() const { return report_; }
+
+ private:
+  friend EffectValidationResult validate_effects(const ValidatedEvaluator& nominal, const Effects& effects,
+                                                 const EffectValidationOptions& options);
+  ValidatedEffectModel(ValidatedEvaluator nominal, Effects effects, EffectValidationReport report)
+      : nominal_(std::move(nominal)), effects_(effects), report_(std::move(report)) {}
+  ValidatedEvaluator nominal_;
+  Effects effects_;
+  EffectValidationReport report_;
+};
+
+class EffectValidationResult {
+ public:
+  bool passed() const { return report_.passed; }
+  const EffectValidationReport& report() const { return report_; }
+  /// The validated model; throws ValidationFailed naming the failing modes otherwise.
+  const ValidatedEffectModel& model() const;
+
+ private:
+  friend EffectValidationResult validate_effects(const ValidatedEvaluator& nominal, const Effects& effects,
+                                                 const EffectValidationOptions& options);
+  EffectValidationReport report_;
+  std::optional<ValidatedEffectModel> validated_;
+};
+
+/// The effects gate.  Never throws for a failing flow: the result says so.
+EffectValidationResult validate_effects(const ValidatedEvaluator& nominal, const Effects& effects,
+                                        const EffectValidationOptions& options = {});
+
+/// The accumulation threshold of docs/effects.md: a bounce series whose remaining duration is
+/// below this fraction of the servo period is summed, not simulated.
+inline constexpr double accumulation_fraction = 1e-7;
+
+/// Simulates from `start`.  Without effects (and without options.general_engine) this is
+/// simulate() on the nominal evaluator, bit for bit.
+SimulationResult simulate_effects(const ValidatedEffectModel& model, const HybridState& start,
+                                  const SimulationOptions& options);
+/// effects_step_start(p, e, step) simulated.
+SimulationResult simulate_effects_step(const ValidatedEffectModel& model, double step,
+                                       const SimulationOptions& options);
+
+namespace detail {
+/// The delayed model (Boost.Odeint, method of steps): effects_delay.cpp.
+SimulationResult simulate_delayed(const Parameters& p, const Effects& e, const HybridState& start,
+                                  const SimulationOptions& options);
+}  // namespace detail
+
+}  // namespace backlash::numeric

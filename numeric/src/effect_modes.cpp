@@ -1,0 +1,391 @@
+#include "backlash/numeric/effect_modes.hpp"
+
+#include "backlash/numeric/phi_functions.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <sstream>
+
+namespace backlash::numeric {
+
+namespace {
+
+bool at_motor(const Parameters& p) { return p.measured_at == model::MeasuredAt::Motor; }
+
+// The drive torque in a regime for the measured shaft at θo (no delay in a closed-form mode).
+double drive_at(const Parameters& p, const Effects& e, double theta_o, int regime) {
+  return drive_torque_in_regime(p, e, theta_o, regime);
+}
+
+}  // namespace
+
+std::string Mode::describe() const {
+  std::ostringstream out;
+  auto slip = [](int s) { return s > 0 ? "+" : s < 0 ? "-" : "stuck"; };
+  switch (kind) {
+    case ModeKind::Contact: out << "contact face " << face << " pair " << slip(slip_motor); break;
+    case ModeKind::Free: out << "free (left face " << face << ") motor " << slip(slip_motor) << " load " << slip(slip_load); break;
+    case ModeKind::Mesh: out << "mesh face " << face << " motor " << slip(slip_motor) << " load " << slip(slip_load); break;
+  }
+  if (regime != 0) out << ", drive clipped " << (regime > 0 ? "+L" : "-L");
+  return out.str();
+}
+
+std::vector<Mode> reachable_modes(const Parameters& p, const Effects& e) {
+  (void)p;
+  std::vector<Mode> modes;
+  const std::vector<int> regimes = e.saturating() ? std::vector<int>{0, 1, -1} : std::vector<int>{0};
+  const std::vector<int> pair_slips = e.coulomb() ? std::vector<int>{1, -1, 0} : std::vector<int>{1, -1};
+  const std::vector<int> motor_slips = e.coulomb_motor > 0 ? std::vector<int>{1, -1, 0} : std::vector<int>{1, -1};
+  const std::vector<int> load_slips = e.coulomb_load > 0 ? std::vector<int>{1, -1, 0} : std::vector<int>{1, -1};
+  for (int face : {-1, 1})
+    for (int regime : regimes) {
+      if (!e.compliant())
+        for (int s : pair_slips) modes.push_back({ModeKind::Contact, face, regime, s, s});
+      for (int sm : motor_slips)
+        for (int sl : load_slips) {
+          modes.push_back({ModeKind::Free, face, regime, sm, sl});
+          if (e.compliant()) modes.push_back({ModeKind::Mesh, face, regime, sm, sl});
+        }
+    }
+  return modes;
+}
+
+double penetration(const Parameters& p, int face, const HybridState& s) {
+  return face * (s.theta_L - s.theta_m) - p.backlash / 2;
+}
+
+double mesh_force(const Parameters& p, const Effects& e, int face, const HybridState& s) {
+  return e.mesh_stiffness * penetration(p, face, s) + e.mesh_damping * face * (s.dtheta_L - s.dtheta_m);
+}
+
+double motor_static_torque(const Parameters& p, const Effects& e, const HybridState& s) {
+  double torque = drive_at(p, e, measured(p, s), s.drive_regime);
+  if (e.compliant() && s.in_contact) torque += s.face * mesh_force(p, e, s.face, s);
+  return torque;
+}
+
+double load_static_torque(const Parameters& p, const Effects& e, const HybridState& s) {
+  if (e.compliant() && s.in_contact) return -s.face * mesh_force(p, e, s.face, s);
+  return 0;
+}
+
+double contact_torque(const Parameters& p, const Effects& e, const Mode& m, const HybridState& s) {
+  const double J = p.Jm + p.JL, F = p.Fm + p.FL, omega = s.dtheta_m;
+  const int slip = m.slip_motor;
+  if (slip == 0) return 0;
+  const double acceleration =
+      (drive_at(p, e, measured(p, s), m.regime) - F * omega - (e.coulomb_motor + e.coulomb_load) * slip) / J;
+  return p.JL * acceleration + p.FL * omega + e.coulomb_load * slip;
+}
+
+// ------------------------------------------------------------------ the generic flow (mesh modes)
+
+// z̃(τ) = e^{Mτ} z̃0 for the augmented M = [[A, c], [0, 0]]: by the eigen-decomposition of M when
+// it is diagonalisable with a well-conditioned basis (the generic mesh mode: two complex pairs
+// and the augmentation's 0), else by Eigen's Padé exponential at each τ.
+struct ModeFlow::Generic {
+  using Matrix5 = Eigen::Matrix<double, 5, 5>;
+  using ComplexMatrix5 = Eigen::Matrix<std::complex<double>, 5, 5>;
+  using ComplexVector5 = Eigen::Matrix<std::complex<double>, 5, 1>;
+  int n = 4;
+  Matrix5 M = Matrix5::Zero();
+  Eigen::Matrix<double, 5, 1> z0 = Eigen::Matrix<double, 5, 1>::Zero();
+  bool diagonal = false;
+  ComplexVector5 lambda, q;
+  ComplexMatrix5 V;
+
+  Generic(const LinearSegment& s, const SmallVector& start) : n(static_cast<int>(s.A.rows())) {
+    M.topLeftCorner(n, n) = s.A;
+    M.block(0, n, n, 1) = s.c;
+    z0.head(n) = start;
+    z0(n) = 1;
+    const int m = n + 1;
+    Eigen::EigenSolver<Eigen::MatrixXd> solver(M.topLeftCorner(m, m), true);
+    if (solver.info() != Eigen::Success) return;
+    const Eigen::MatrixXcd vectors = solver.eigenvectors();
+    const Eigen::VectorXcd values = solver.eigenvalues();
+    Eigen::PartialPivLU<Eigen::MatrixXcd> lu(vectors);
+    const Eigen::MatrixXcd inverse = lu.inverse();
+    const double condition = vectors.cwiseAbs().rowwise().sum().maxCoeff() * inverse.cwiseAbs().rowwise().sum().maxCoeff();
+    if (!std::isfinite(condition) || condition > 1e7) return;
+    V = ComplexMatrix5::Zero();
+    V.topLeftCorner(m, m) = vectors;
+    lambda = ComplexVector5::Zero();
+    lambda.head(m) = values;
+    q = ComplexVector5::Zero();
+    q.head(m) = inverse * z0.head(m).cast<std::complex<double>>();
+    diagonal = true;
+  }
+
+  SmallVector at(double tau) const {
+    const int m = n + 1;
+    if (diagonal) {
+      Eigen::Matrix<std::complex<double>, 5, 1> weights = Eigen::Matrix<std::complex<double>, 5, 1>::Zero();
+      for (int j = 0; j < m; ++j) weights(j) = std::exp(lambda(j) * tau) * q(j);
+      SmallVector z(n);
+      for (int i = 0; i < n; ++i) {
+        std::complex<double> sum = 0;
+        for (int j = 0; j < m; ++j) sum += V(i, j) * weights(j);
+        z(i) = sum.real();
+      }
+      return z;
+    }
+    const Eigen::MatrixXd E = (Eigen::MatrixXd(M.topLeftCorner(m, m)) * tau).exp();
+    return SmallVector((E * z0.head(m)).head(n));
+  }
+};
+
+// ------------------------------------------------------------------ ModeFlow
+
+ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start)
+    : p_(p), e_(e), mode_(m), start_(start) {
+  const double J = p.Jm + p.JL, F = p.Fm + p.FL;
+  const double T = e.coulomb_motor + e.coulomb_load;
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  const double offset = std::fabs(e.torque_offset);
+  if (m.kind == ModeKind::Contact) {
+    segment_ = LinearSegment{SmallMatrix::Zero(2, 2), SmallVector::Zero(2)};
+    z0_ = SmallVector::Zero(2);
+    z0_noise_ = SmallVector::Zero(2);
+    c_magnitude_ = SmallVector::Zero(2);
+    const double omega0 = start.dtheta_m;
+    if (m.slip_motor == 0) return;  // stuck: nothing moves
+    z0_noise_(1) = 4 * eps * std::fabs(omega0);
+    segment_.A(0, 1) = 1;
+    if (m.regime == 0) {
+      y_star_ = (e.torque_offset - T * m.slip_motor) / p.K;
+      alpha_ = F / (2 * J);
+      w2_ = p.K / J;
+      segment_.A(1, 0) = -p.K / J;
+      segment_.A(1, 1) = -F / J;
+      z0_ << measured(p, start) - p.theta_R - y_star_, omega0;
+      z0_noise_(0) = 4 * eps * (std::fabs(measured(p, start)) + std::fabs(p.theta_R) + (offset + T) / p.K);
+    } else {
+      beta_ = F / J;
+      g_ = (m.regime * e.saturation + e.torque_offset - T * m.slip_motor) / J;
+      segment_.A(1, 1) = -beta_;
+      segment_.c(1) = g_;
+      c_magnitude_(1) = (e.saturation + offset + T) / J;
+      z0_ << 0, omega0;
+    }
+    return;
+  }
+  // Free flight and mesh: z = (Δm, θ̇m, ΔL, θ̇L).
+  segment_ = LinearSegment{SmallMatrix::Zero(4, 4), SmallVector::Zero(4)};
+  z0_ = SmallVector::Zero(4);
+  z0_ << 0, start.dtheta_m, 0, start.dtheta_L;
+  z0_noise_ = SmallVector::Zero(4);
+  z0_noise_ << 0, 4 * eps * std::fabs(start.dtheta_m), 0, 4 * eps * std::fabs(start.dtheta_L);
+  c_magnitude_ = SmallVector::Zero(4);
+  LinearSegment& s = segment_;
+  s.A(0, 1) = 1;
+  s.A(2, 3) = 1;
+  const double theta_o0 = measured(p, start);
+  const bool linear_drive = m.regime == 0;
+  const double drive0 = drive_at(p, e, theta_o0, m.regime);
+  const double drive_magnitude =
+      (linear_drive ? p.K * (std::fabs(p.theta_R) + std::fabs(theta_o0)) : e.saturation) + offset;
+  if (m.slip_motor != 0) {
+    if (linear_drive) (at_motor(p) ? s.A(1, 0) : s.A(1, 2)) = -p.K / p.Jm;
+    s.A(1, 1) = -p.Fm / p.Jm;
+    s.c(1) = (drive0 - e.coulomb_motor * m.slip_motor) / p.Jm;
+    c_magnitude_(1) = (drive_magnitude + e.coulomb_motor) / p.Jm;
+  }
+  if (m.slip_load != 0) {
+    s.A(3, 3) = -p.FL / p.JL;
+    s.c(3) = -e.coulomb_load * m.slip_load / p.JL;
+    c_magnitude_(3) = e.coulomb_load / p.JL;
+  }
+  if (m.kind == ModeKind::Mesh) {
+    // σP = kc (x0 + ΔL − Δm) − σ kc b/2 + cc (θ̇L − θ̇m) acts on the motor (+σP) and the load (−σP).
+    const double kc = e.mesh_stiffness, cc = e.mesh_damping, sigma = m.face;
+    const double x0 = start.theta_L - start.theta_m;
+    const double constant = kc * x0 - sigma * kc * p.backlash / 2;
+    const double constant_magnitude = kc * (std::fabs(start.theta_L) + std::fabs(start.theta_m) + p.backlash / 2);
+    if (m.slip_motor != 0) {
+      s.A(1, 0) += -kc / p.Jm;
+      s.A(1, 1) += -cc / p.Jm;
+      s.A(1, 2) += kc / p.Jm;
+      s.A(1, 3) += cc / p.Jm;
+      s.c(1) += constant / p.Jm;
+      c_magnitude_(1) += constant_magnitude / p.Jm;
+    }
+    if (m.slip_load != 0) {
+      s.A(3, 0) += kc / p.JL;
+      s.A(3, 1) += cc / p.JL;
+      s.A(3, 2) += -kc / p.JL;
+      s.A(3, 3) += -cc / p.JL;
+      s.c(3) += -constant / p.JL;
+      c_magnitude_(3) += constant_magnitude / p.JL;
+    }
+    generic_ = std::make_shared<const Generic>(segment_, z0_);
+    return;
+  }
+  // Free flight: closed forms.
+  a_ = p.Fm / p.Jm;
+  b_ = p.FL / p.JL;
+  k_ = p.K / p.Jm;
+  gL_ = s.c(3);
+  if (m.slip_motor == 0) {
+    motor_form_ = 0;
+  } else if (!linear_drive || (!at_motor(p) && m.slip_load == 0)) {
+    motor_form_ = 1;  // constant drive
+    gm_ = s.c(1);
+  } else if (at_motor(p)) {
+    motor_form_ = 2;  // its own closed loop
+    y_star_ = (e.torque_offset - e.coulomb_motor * m.slip_motor) / p.K;
+    alpha_m_ = p.Fm / (2 * p.Jm);
+    w2_m_ = p.K / p.Jm;
+  } else {
+    motor_form_ = 3;  // driven by the moving load
+    c0_ = s.c(1);
+  }
+}
+
+SmallVector ModeFlow::local(double tau) const {
+  const Mode& m = mode_;
+  if (generic_) return generic_->at(tau);
+  if (m.kind == ModeKind::Contact) {
+    SmallVector z(2);
+    if (m.slip_motor == 0) {
+      z << 0, 0;
+    } else if (m.regime == 0) {
+      const DampedPair dp = damped_pair(alpha_, w2_, tau);
+      const double d0 = z0_(0), w0 = z0_(1);
+      z << d0 * dp.c + (w0 + alpha_ * d0) * dp.s, w0 * dp.c - (alpha_ * w0 + w2_ * d0) * dp.s;
+    } else {
+      const double x = -beta_ * tau, w0 = z0_(1);
+      z << w0 * tau * phi(1, x) + g_ * tau * tau * phi(2, x), w0 * std::exp(x) + g_ * tau * phi(1, x);
+    }
+    return z;
+  }
+  SmallVector z(4);
+  const double vm0 = z0_(1), vL0 = z0_(3);
+  const double y = -b_ * tau, x = -a_ * tau;
+  // load
+  if (m.slip_load == 0) {
+    z(2) = 0;
+    z(3) = 0;
+  } else {
+    const double phi1 = phi(1, y);
+    z(2) = vL0 * tau * phi1 + gL_ * tau * tau * phi(2, y);
+    z(3) = vL0 * std::exp(y) + gL_ * tau * phi1;
+  }
+  switch (motor_form_) {
+    case 0:
+      z(0) = 0;
+      z(1) = 0;
+      break;
+    case 1: {
+      const double phi1 = phi(1, x);
+      z(0) = vm0 * tau * phi1 + gm_ * tau * tau * phi(2, x);
+      z(1) = vm0 * std::exp(x) + gm_ * tau * phi1;
+      break;
+    }
+    case 2: {
+      const double y0 = measured(p_, start_) - p_.theta_R - y_star_;
+      const DampedPair dp = damped_pair(alpha_m_, w2_m_, tau);
+      z(0) = y0 * (dp.c - 1) + (vm0 + alpha_m_ * y0) * dp.s;
+      z(1) = vm0 * dp.c - (alpha_m_ * vm0 + w2_m_ * y0) * dp.s;
+      break;
+    }
+    default: {
+      const double phi1 = phi(1, x), t2 = tau * tau;
+      const double A1 = exp_divided_difference(1, x, y), A2 = exp_divided_difference(2, x, y),
+                   A3 = exp_divided_difference(3, x, y);
+      z(0) = vm0 * tau * phi1 + c0_ * t2 * phi(2, x) - k_ * vL0 * t2 * tau * A2 - k_ * gL_ * t2 * t2 * A3;
+      z(1) = vm0 * std::exp(x) + c0_ * tau * phi1 - k_ * vL0 * t2 * A1 - k_ * gL_ * t2 * tau * A2;
+      break;
+    }
+  }
+  return z;
+}
+
+HybridState ModeFlow::state_of(const SmallVector& z) const {
+  HybridState h;
+  const Mode& m = mode_;
+  if (m.kind == ModeKind::Contact) {
+    const double theta_o = p_.theta_R + theta_o_error().constant + z(0);
+    h = state_on_face(p_, m.face, theta_o, z(1), true);
+    h.motor_stuck = h.load_stuck = m.slip_motor == 0;
+  } else {
+    h.theta_m = start_.theta_m + z(0);
+    h.dtheta_m = z(1);
+    h.theta_L = start_.theta_L + z(2);
+    h.dtheta_L = z(3);
+    h.in_contact = m.kind == ModeKind::Mesh;
+    h.face = m.face;
+    h.motor_stuck = m.slip_motor == 0;
+    h.load_stuck = m.slip_load == 0;
+  }
+  h.drive_regime = m.regime;
+  return h;
+}
+
+bool ModeFlow::uses_matrix_exponential() const { return generic_ && !generic_->diagonal; }
+
+HybridState ModeFlow::state(double tau) const { return state_of(local(tau)); }
+
+ModeFlow::Functional ModeFlow::theta_o_error() const {
+  Functional f;
+  if (mode_.kind == ModeKind::Contact) {
+    f.row = SmallRow::Zero(2);
+    f.row(0) = 1;
+    f.constant = mode_.slip_motor != 0 && mode_.regime == 0 ? y_star_ : measured(p_, start_) - p_.theta_R;
+    f.magnitude = std::fabs(measured(p_, start_)) + std::fabs(p_.theta_R) + std::fabs(y_star_);
+    return f;
+  }
+  f.row = SmallRow::Zero(4);
+  f.row(at_motor(p_) ? 0 : 2) = 1;
+  f.constant = measured(p_, start_) - p_.theta_R;
+  f.magnitude = std::fabs(measured(p_, start_)) + std::fabs(p_.theta_R);
+  return f;
+}
+
+ModeFlow::Functional ModeFlow::gap_functional() const {
+  Functional f;
+  if (mode_.kind == ModeKind::Contact) {
+    f.row = SmallRow::Zero(2);
+    f.constant = mode_.face * p_.backlash / 2;
+    f.magnitude = p_.backlash / 2;
+    return f;
+  }
+  f.row = SmallRow::Zero(4);
+  f.row(0) = -1;
+  f.row(2) = 1;
+  f.constant = start_.theta_L - start_.theta_m;
+  f.magnitude = std::fabs(start_.theta_L) + std::fabs(start_.theta_m);
+  return f;
+}
+
+ModeFlow::Functional ModeFlow::motor_velocity() const {
+  Functional f;
+  f.row = SmallRow::Zero(segment_.A.rows());
+  f.row(1) = 1;
+  return f;
+}
+
+ModeFlow::Functional ModeFlow::load_velocity() const {
+  Functional f;
+  f.row = SmallRow::Zero(segment_.A.rows());
+  f.row(mode_.kind == ModeKind::Contact ? 1 : 3) = 1;
+  return f;
+}
+
+double ModeFlow::gap(const SmallVector& z) const {
+  const Functional f = gap_functional();
+  return f.row.dot(z) + f.constant;
+}
+
+double ModeFlow::theta_o(const SmallVector& z) const {
+  const Functional f = theta_o_error();
+  return p_.theta_R + f.row.dot(z) + f.constant;
+}
+
+}  // namespace backlash::numeric
