@@ -8,7 +8,10 @@
 #include "commands.hpp"
 
 #include "backlash/model/case_spec.hpp"
+#include "backlash/numeric/effects_simulation.hpp"
 #include "backlash/numeric/validation.hpp"
+
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <sstream>
@@ -20,7 +23,10 @@ namespace backlash::cli {
 struct ValidatedCase {
   model::CaseSpec spec;
   numeric::ValidationResult validation;
+  numeric::EffectValidationResult effects;  ///< the [effects] table's modes through their gate
   const numeric::ValidatedEvaluator& evaluator() const { return validation.evaluator(); }
+  /// The model with its effects (the nominal model when the case has none).
+  const numeric::ValidatedEffectModel& model() const { return effects.model(); }
 };
 
 inline ValidatedCase validated_case(const std::string& case_name) {
@@ -33,7 +39,22 @@ inline ValidatedCase validated_case(const std::string& case_name) {
     throw std::runtime_error("case " + spec.id + ": the evaluator failed validation against odeint (" + failing +
                              "); refusing to use it");
   }
-  return ValidatedCase{std::move(spec), std::move(result)};
+  numeric::EffectValidationResult effects = numeric::validate_effects(result.evaluator(), numeric::effects_of(spec));
+  if (!effects.passed()) (void)effects.model();  // throws, naming the failing modes
+  return ValidatedCase{std::move(spec), std::move(result), std::move(effects)};
+}
+
+/// The effects as JSON: {"coulomb_load": 0.03, ...}, only those present.
+inline nlohmann::json effects_json(const numeric::Effects& e) {
+  nlohmann::json out = nlohmann::json::object();
+  if (e.coulomb_motor > 0) out["coulomb_motor"] = e.coulomb_motor;
+  if (e.coulomb_load > 0) out["coulomb_load"] = e.coulomb_load;
+  if (e.restitution != 0) out["restitution"] = e.restitution;
+  if (e.saturating()) out["saturation"] = e.saturation;
+  if (e.compliant()) out["compliance"] = {{"stiffness", e.mesh_stiffness}, {"damping", e.mesh_damping}};
+  if (e.delayed()) out["delay"] = e.delay;
+  if (e.torque_offset != 0) out["torque_offset"] = e.torque_offset;
+  return out;
 }
 
 /// A finite number, or UsageError naming the flag.

@@ -3,6 +3,7 @@
 #include "commands.hpp"
 #include "numeric_case.hpp"
 
+#include "backlash/numeric/effects_simulation.hpp"
 #include "backlash/numeric/hybrid_simulation.hpp"
 
 #include <nlohmann/json.hpp>
@@ -41,47 +42,58 @@ void run_simulate(const SimulateOptions& options) {
   numeric::SimulationOptions sim;
   sim.t_end = *t_end;
   if (options.csv) sim.sample_interval = dt;
-  const numeric::SimulationResult r = numeric::simulate_step(c.evaluator(), *step, sim);
+  const numeric::SimulationResult r = numeric::simulate_effects_step(c.model(), *step, sim);
+  const numeric::Effects& effects = c.model().effects();
+  const double final_error = r.theta_o_final - c.evaluator().parameters().theta_R;
   if (options.csv) {
     std::printf("t,theta_o,dtheta_o,theta_m,dtheta_m,theta_L,dtheta_L,mode\n");
     for (const numeric::TrajectorySample& s : r.samples)
       std::printf("%.10g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%s\n", s.t, s.theta_o, s.dtheta_o, s.theta_m, s.dtheta_m, s.theta_L,
-                  s.dtheta_L, s.in_contact ? "contact" : "free");
+                  s.dtheta_L, s.in_contact ? (effects.compliant() ? "mesh" : "contact") : "free");
     return;
   }
   if (options.json) {
     nlohmann::json events = nlohmann::json::array();
-    for (const numeric::SimulationEvent& e : r.events)
-      events.push_back({{"t", e.t},
-                        {"kind", numeric::to_string(e.kind)},
-                        {"theta_o", e.theta_o},
-                        {"dtheta_o", e.dtheta_o},
-                        {"theta_m", e.after.theta_m},
-                        {"theta_L", e.after.theta_L},
-                        {"bounce", e.bounce}});
+    for (const numeric::SimulationEvent& e : r.events) {
+      nlohmann::json event{{"t", e.t},
+                           {"kind", numeric::to_string(e.kind)},
+                           {"theta_o", e.theta_o},
+                           {"dtheta_o", e.dtheta_o},
+                           {"theta_m", e.after.theta_m},
+                           {"theta_L", e.after.theta_L},
+                           {"bounce", e.bounce}};
+      if (e.body != numeric::Body::None) event["body"] = numeric::to_string(e.body);
+      if (e.accumulation) event["accumulation"] = true;
+      events.push_back(event);
+    }
     nlohmann::json out{{"case", c.spec.id},
                        {"step", *step},
                        {"t_end", *t_end},
+                       {"effects", effects_json(effects)},
                        {"status", numeric::to_string(r.status)},
                        {"events", events},
                        {"final",
                         {{"t", r.t_final},
                          {"theta_o", r.theta_o_final},
+                         {"error", final_error},
                          {"theta_m", r.final_state.theta_m},
                          {"theta_L", r.final_state.theta_L},
                          {"dtheta_m", r.final_state.dtheta_m},
                          {"dtheta_L", r.final_state.dtheta_L},
-                         {"in_contact", r.final_state.in_contact}}}};
+                         {"in_contact", r.final_state.in_contact},
+                         {"motor_stuck", r.final_state.motor_stuck},
+                         {"load_stuck", r.final_state.load_stuck}}}};
     std::cout << out.dump(2) << "\n";
     return;
   }
-  std::printf("%s, step %g over %g s: %s, %zu events\n", c.spec.id.c_str(), *step, *t_end, numeric::to_string(r.status),
-              r.events.size());
+  std::printf("%s, step %g over %g s: %s, %zu events (effects: %s)\n", c.spec.id.c_str(), *step, *t_end,
+              numeric::to_string(r.status), r.events.size(), effects.describe().c_str());
   for (const numeric::SimulationEvent& e : r.events)
-    std::printf("  t = %14.10f  %-13s theta_o = %12.8f  dtheta_o = %12.8f%s\n", e.t, numeric::to_string(e.kind), e.theta_o,
-                e.dtheta_o, e.bounce ? "  (bounce)" : "");
-  std::printf("final: t = %g  theta_o = %.10f  theta_m = %.10f  theta_L = %.10f\n", r.t_final, r.theta_o_final,
-              r.final_state.theta_m, r.final_state.theta_L);
+    std::printf("  t = %14.10f  %-13s theta_o = %12.8f  dtheta_o = %12.8f%s%s%s\n", e.t, numeric::to_string(e.kind), e.theta_o,
+                e.dtheta_o, e.bounce ? "  (bounce)" : "", e.accumulation ? "  (end of a bounce series)" : "",
+                e.body != numeric::Body::None ? (std::string("  ") + numeric::to_string(e.body)).c_str() : "");
+  std::printf("final: t = %g  theta_o = %.10f  theta_m = %.10f  theta_L = %.10f  error theta_o - theta_R = %.10f\n",
+              r.t_final, r.theta_o_final, r.final_state.theta_m, r.final_state.theta_L, final_error);
 }
 
 }  // namespace

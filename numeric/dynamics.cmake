@@ -14,8 +14,10 @@ target_sources(backlash_numeric PRIVATE
   # Effects the thesis left out (docs/effects.md)
   ${CMAKE_CURRENT_LIST_DIR}/src/effects.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/effect_modes.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/effects_engine.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/effects_simulation.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/effects_validation.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/effects_limit_cycle.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/effects_delay.cpp      # odeint: the delayed model (method of steps)
   ${CMAKE_CURRENT_LIST_DIR}/src/odeint_effects_simulation.cpp)  # odeint: the independent simulator with effects
 find_package(Threads REQUIRED)

@@ -143,64 +143,64 @@ struct ModeFlow::Generic {
 
 // ------------------------------------------------------------------ ModeFlow
 
-ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start)
-    : p_(p), e_(e), mode_(m), start_(start) {
+ModeSystem mode_system(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start,
+                       bool drive_external) {
   const double J = p.Jm + p.JL, F = p.Fm + p.FL;
   const double T = e.coulomb_motor + e.coulomb_load;
   constexpr double eps = std::numeric_limits<double>::epsilon();
   const double offset = std::fabs(e.torque_offset);
+  ModeSystem sys;
+  const int n = m.kind == ModeKind::Contact ? 2 : 4;
+  sys.segment = LinearSegment{SmallMatrix::Zero(n, n), SmallVector::Zero(n)};
+  sys.z0 = SmallVector::Zero(n);
+  sys.z0_noise = SmallVector::Zero(n);
+  sys.c_magnitude = SmallVector::Zero(n);
+  sys.drive_column = SmallVector::Zero(n);
+  LinearSegment& s = sys.segment;
+  const double theta_o0 = measured(p, start);
+  const bool linear_drive = m.regime == 0 && !drive_external;
   if (m.kind == ModeKind::Contact) {
-    segment_ = LinearSegment{SmallMatrix::Zero(2, 2), SmallVector::Zero(2)};
-    z0_ = SmallVector::Zero(2);
-    z0_noise_ = SmallVector::Zero(2);
-    c_magnitude_ = SmallVector::Zero(2);
     const double omega0 = start.dtheta_m;
-    if (m.slip_motor == 0) return;  // stuck: nothing moves
-    z0_noise_(1) = 4 * eps * std::fabs(omega0);
-    segment_.A(0, 1) = 1;
-    if (m.regime == 0) {
-      y_star_ = (e.torque_offset - T * m.slip_motor) / p.K;
-      alpha_ = F / (2 * J);
-      w2_ = p.K / J;
-      segment_.A(1, 0) = -p.K / J;
-      segment_.A(1, 1) = -F / J;
-      z0_ << measured(p, start) - p.theta_R - y_star_, omega0;
-      z0_noise_(0) = 4 * eps * (std::fabs(measured(p, start)) + std::fabs(p.theta_R) + (offset + T) / p.K);
-    } else {
-      beta_ = F / J;
-      g_ = (m.regime * e.saturation + e.torque_offset - T * m.slip_motor) / J;
-      segment_.A(1, 1) = -beta_;
-      segment_.c(1) = g_;
-      c_magnitude_(1) = (e.saturation + offset + T) / J;
-      z0_ << 0, omega0;
+    if (m.slip_motor == 0) return sys;  // stuck: nothing moves
+    sys.z0_noise(1) = 4 * eps * std::fabs(omega0);
+    s.A(0, 1) = 1;
+    s.A(1, 1) = -F / J;
+    if (linear_drive) {  // z = (d, ω), d = θo − θR − y*: J d'' + F d' + K d = 0
+      const double y_star = (e.torque_offset - T * m.slip_motor) / p.K;
+      s.A(1, 0) = -p.K / J;
+      sys.z0 << theta_o0 - p.theta_R - y_star, omega0;
+      sys.z0_noise(0) = 4 * eps * (std::fabs(theta_o0) + std::fabs(p.theta_R) + (offset + T) / p.K);
+    } else {  // z = (Δ, ω): J Δ'' + F Δ' = D − T s
+      const double drive = drive_external ? 0.0 : m.regime * e.saturation + e.torque_offset;
+      s.c(1) = (drive - T * m.slip_motor) / J;
+      sys.c_magnitude(1) = ((drive_external ? 0.0 : e.saturation + offset) + T) / J;
+      if (drive_external) sys.drive_column(1) = 1 / J;
+      sys.z0 << 0, omega0;
     }
-    return;
+    return sys;
   }
   // Free flight and mesh: z = (Δm, θ̇m, ΔL, θ̇L).
-  segment_ = LinearSegment{SmallMatrix::Zero(4, 4), SmallVector::Zero(4)};
-  z0_ = SmallVector::Zero(4);
-  z0_ << 0, start.dtheta_m, 0, start.dtheta_L;
-  z0_noise_ = SmallVector::Zero(4);
-  z0_noise_ << 0, 4 * eps * std::fabs(start.dtheta_m), 0, 4 * eps * std::fabs(start.dtheta_L);
-  c_magnitude_ = SmallVector::Zero(4);
-  LinearSegment& s = segment_;
+  sys.z0 << 0, start.dtheta_m, 0, start.dtheta_L;
+  sys.z0_noise << 0, 4 * eps * std::fabs(start.dtheta_m), 0, 4 * eps * std::fabs(start.dtheta_L);
   s.A(0, 1) = 1;
   s.A(2, 3) = 1;
-  const double theta_o0 = measured(p, start);
-  const bool linear_drive = m.regime == 0;
-  const double drive0 = drive_at(p, e, theta_o0, m.regime);
-  const double drive_magnitude =
-      (linear_drive ? p.K * (std::fabs(p.theta_R) + std::fabs(theta_o0)) : e.saturation) + offset;
   if (m.slip_motor != 0) {
-    if (linear_drive) (at_motor(p) ? s.A(1, 0) : s.A(1, 2)) = -p.K / p.Jm;
+    double drive = 0, drive_magnitude = 0;
+    if (drive_external) {
+      sys.drive_column(1) = 1 / p.Jm;
+    } else {
+      drive = drive_at(p, e, theta_o0, m.regime);
+      drive_magnitude = (linear_drive ? p.K * (std::fabs(p.theta_R) + std::fabs(theta_o0)) : e.saturation) + offset;
+      if (linear_drive) (at_motor(p) ? s.A(1, 0) : s.A(1, 2)) = -p.K / p.Jm;
+    }
     s.A(1, 1) = -p.Fm / p.Jm;
-    s.c(1) = (drive0 - e.coulomb_motor * m.slip_motor) / p.Jm;
-    c_magnitude_(1) = (drive_magnitude + e.coulomb_motor) / p.Jm;
+    s.c(1) = (drive - e.coulomb_motor * m.slip_motor) / p.Jm;
+    sys.c_magnitude(1) = (drive_magnitude + e.coulomb_motor) / p.Jm;
   }
   if (m.slip_load != 0) {
     s.A(3, 3) = -p.FL / p.JL;
     s.c(3) = -e.coulomb_load * m.slip_load / p.JL;
-    c_magnitude_(3) = e.coulomb_load / p.JL;
+    sys.c_magnitude(3) = e.coulomb_load / p.JL;
   }
   if (m.kind == ModeKind::Mesh) {
     // σP = kc (x0 + ΔL − Δm) − σ kc b/2 + cc (θ̇L − θ̇m) acts on the motor (+σP) and the load (−σP).
@@ -214,7 +214,7 @@ ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const H
       s.A(1, 2) += kc / p.Jm;
       s.A(1, 3) += cc / p.Jm;
       s.c(1) += constant / p.Jm;
-      c_magnitude_(1) += constant_magnitude / p.Jm;
+      sys.c_magnitude(1) += constant_magnitude / p.Jm;
     }
     if (m.slip_load != 0) {
       s.A(3, 0) += kc / p.JL;
@@ -222,8 +222,34 @@ ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const H
       s.A(3, 2) += -kc / p.JL;
       s.A(3, 3) += -cc / p.JL;
       s.c(3) += -constant / p.JL;
-      c_magnitude_(3) += constant_magnitude / p.JL;
+      sys.c_magnitude(3) += constant_magnitude / p.JL;
     }
+  }
+  return sys;
+}
+
+ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start)
+    : p_(p), e_(e), mode_(m), start_(start) {
+  const ModeSystem sys = mode_system(p, e, m, start, false);
+  segment_ = sys.segment;
+  z0_ = sys.z0;
+  z0_noise_ = sys.z0_noise;
+  c_magnitude_ = sys.c_magnitude;
+  const double J = p.Jm + p.JL, F = p.Fm + p.FL;
+  const double T = e.coulomb_motor + e.coulomb_load;
+  if (m.kind == ModeKind::Contact) {
+    if (m.slip_motor == 0) return;
+    if (m.regime == 0) {
+      y_star_ = (e.torque_offset - T * m.slip_motor) / p.K;
+      alpha_ = F / (2 * J);
+      w2_ = p.K / J;
+    } else {
+      beta_ = F / J;
+      g_ = segment_.c(1);
+    }
+    return;
+  }
+  if (m.kind == ModeKind::Mesh) {
     generic_ = std::make_shared<const Generic>(segment_, z0_);
     return;
   }
@@ -231,12 +257,12 @@ ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const H
   a_ = p.Fm / p.Jm;
   b_ = p.FL / p.JL;
   k_ = p.K / p.Jm;
-  gL_ = s.c(3);
+  gL_ = segment_.c(3);
   if (m.slip_motor == 0) {
     motor_form_ = 0;
-  } else if (!linear_drive || (!at_motor(p) && m.slip_load == 0)) {
+  } else if (m.regime != 0 || (!at_motor(p) && m.slip_load == 0)) {
     motor_form_ = 1;  // constant drive
-    gm_ = s.c(1);
+    gm_ = segment_.c(1);
   } else if (at_motor(p)) {
     motor_form_ = 2;  // its own closed loop
     y_star_ = (e.torque_offset - e.coulomb_motor * m.slip_motor) / p.K;
@@ -244,7 +270,7 @@ ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const H
     w2_m_ = p.K / p.Jm;
   } else {
     motor_form_ = 3;  // driven by the moving load
-    c0_ = s.c(1);
+    c0_ = segment_.c(1);
   }
 }
 
@@ -329,6 +355,24 @@ HybridState ModeFlow::state_of(const SmallVector& z) const {
 }
 
 bool ModeFlow::uses_matrix_exponential() const { return generic_ && !generic_->diagonal; }
+
+std::function<double(double, double)> ModeFlow::derivative_bound(const SmallRow& row, int order) const {
+  if (!generic_ || !generic_->diagonal) return {};
+  const Generic& g = *generic_;
+  const int m = g.n + 1;
+  std::vector<std::pair<double, double>> terms;  // (|c_j||λ_j|^order, Re λ_j)
+  for (int j = 0; j < m; ++j) {
+    std::complex<double> c = 0;
+    for (int i = 0; i < g.n; ++i) c += row(i) * g.V(i, j);
+    const double size = std::abs(c * g.q(j)) * std::pow(std::abs(g.lambda(j)), order);
+    if (size > 0) terms.push_back({size, g.lambda(j).real()});
+  }
+  return [terms](double a, double b) {
+    double bound = 0;
+    for (const auto& [size, rate] : terms) bound += size * std::exp(rate * (rate > 0 ? b : a));
+    return bound * (1 + 1e-9) + 1e-300;
+  };
+}
 
 HybridState ModeFlow::state(double tau) const { return state_of(local(tau)); }
 

@@ -86,7 +86,7 @@ std::optional<Crossing> first_crossing(const LinearWitness& witness, double t_be
     if (!std::isfinite(a.w) || !std::isfinite(b.w)) throw std::runtime_error("first_crossing: non-finite witness");
     if (a.w == 0 && a.t > t_begin) return Crossing{a.t, false, examined};
     const double h = b.t - a.t;
-    const double M3 = W.third_bound(a, h);
+    const double M3 = witness.third_derivative_bound ? witness.third_derivative_bound(a.t, b.t) : W.third_bound(a, h);
     const double M2 = 0.5 * (std::fabs(a.w2) + std::fabs(b.w2) + h * M3);
     const double M1 = 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) + h * M2);
     const bool sign_change = !same_sign(a.w, b.w);

@@ -41,6 +41,7 @@
 #include "backlash/numeric/first_crossing.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -73,6 +74,17 @@ double mesh_force(const Parameters& p, const Effects& e, int face, const HybridS
 
 /// Transmitted torque in rigid contact, Tc = JL ω̇ + FL ω + TL s.
 double contact_torque(const Parameters& p, const Effects& e, const Mode& m, const HybridState& s);
+
+/// A mode's linear system z' = A z + c (+ drive_column·D(t) when the drive is kept
+/// external, as with a delay: then the contact coordinates are (Δ, ω) and no drive term
+/// is folded into A or c), its start z0, the rounding z0 carries, and the size of the
+/// terms that formed c.
+struct ModeSystem {
+  LinearSegment segment;
+  SmallVector z0, z0_noise, c_magnitude, drive_column;
+};
+ModeSystem mode_system(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start,
+                       bool drive_external);
 
 /// A mode's closed-form motion from a state.
 class ModeFlow {
@@ -109,6 +121,10 @@ class ModeFlow {
   Functional load_velocity() const;
   /// The generic (mesh) flow could not use its eigen-decomposition and evaluates e^{Mτ}.
   bool uses_matrix_exponential() const;
+  /// For a flow known as a sum of exponentials (the mesh modes' eigen-decomposition):
+  /// sup over [a, b] of |d^k/dτ^k row·z(τ)| ≤ Σ_j |row·V_j q_j| |λ_j|^k max(e^{Re λ_j a}, e^{Re λ_j b}).
+  /// Empty otherwise (the closed forms are not stiff: the generic bound serves).
+  std::function<double(double, double)> derivative_bound(const SmallRow& row, int order) const;
 
  private:
   struct Generic;

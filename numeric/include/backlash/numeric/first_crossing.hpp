@@ -43,6 +43,10 @@ struct LinearWitness {
   /// Optional: w(t) + level computed directly by the closed form (e.g. the gap,
   /// free of the cancellation in θL − θm); otherwise eᵀx(t).
   std::function<double(double)> value;
+  /// Optional: a bound on sup|w'''| over [a, b] tighter than ‖eᵀA²‖₁ e^{‖A‖(b−a)} ‖x'(a)‖∞ — for
+  /// a stiff segment known as a sum of exponentials Σ c_j e^{λ_j t}: Σ |c_j||λ_j|³ times the
+  /// larger of e^{Re λ_j t} at the ends (a decayed fast mode then bounds nothing).
+  std::function<double(double, double)> third_derivative_bound;
 };
 
 struct Crossing {

@@ -55,6 +55,7 @@ struct SimulationEvent {
   EventKind kind = EventKind::Separation;
   double theta_o = 0, dtheta_o = 0;  ///< measured shaft, velocity after the event
   HybridState after;
+  HybridState before;                ///< (effects engine) the state just before an impact
   bool bounce = false;               ///< impact after which contact did not hold
   bool grazing = false;
   Body body = Body::None;            ///< stick / slip: which body
@@ -72,7 +73,12 @@ struct SimulationOptions {
   int zeno_impacts = 100;       ///< chattering when this many impacts happen within zeno_window
   double zeno_window = 1e-6;
   long stop_after_separations = 0;  ///< > 0: stop (status completed) right after this many separations
+  /// (effects engine) stop_at_face = ±1: stop right after the first event of kind stop_at_kind
+  /// whose face (the face left by a separation, hit by an impact) is stop_at_face, at t > 0.
+  int stop_at_face = 0;
+  EventKind stop_at_kind = EventKind::Recombination;
   bool track_extremes = false;      ///< record the exact extremes of θo, θm, θL (zeros of the velocities)
+  double extremes_after = 0;        ///< (effects engine) extremes only of segments starting at or after this time
   bool general_engine = false;      ///< simulate_effects: run the effects engine even when every effect is neutral
 };
 

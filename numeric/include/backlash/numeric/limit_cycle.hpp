@@ -59,6 +59,11 @@ struct LimitCycle {
   int contact_arc_crossings_of_theta_R = 0;  ///< crossings of θo = θR between recombination and separation
   bool bounced = false;
   std::vector<double> other_fixed_points;     ///< further (e.g. unstable) cycles found
+  // With effects (effects_limit_cycle.hpp):
+  std::string method = "half-cycle map";      ///< or "return map (Newton)", "return map (iteration)"
+  double residual = 0;                        ///< |P(s*) − s*| at the fixed point (section coordinates)
+  int iterations = 0;                         ///< full cycles iterated before convergence
+  double rest_error = 0;                      ///< "none" because the motion stops: θo − θR at rest
 };
 
 struct LimitCycleOptions {
