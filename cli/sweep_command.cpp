@@ -17,6 +17,9 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -47,10 +50,12 @@ std::vector<numeric::SweepPoint> custom_points(const SweepOptions& o, int n) {
   const double a = parse_number(o.from, "--from"), b = parse_number(o.to, "--to");
   const model::CaseSpec spec = model::load_case(o.target);
   const numeric::Parameters base = numeric::parameters_of(spec);
+  const numeric::Effects base_effects = numeric::effects_of(spec);
   std::vector<numeric::SweepPoint> points;
   for (int i = 0; i < n; ++i) {
     const double x = n == 1 ? a : a + (b - a) * i / double(n - 1);
     numeric::Parameters p = base;
+    numeric::Effects e = base_effects;
     const std::string& v = o.vary;
     if (v == "Jm") p.Jm = x;
     else if (v == "Fm") p.Fm = x;
@@ -61,10 +66,26 @@ std::vector<numeric::SweepPoint> custom_points(const SweepOptions& o, int n) {
     else if (v == "reference") p.theta_R = x;
     else if (v == "JL_over_Jm") { const double J = base.Jm + base.JL; p.Jm = J / (1 + x); p.JL = J * x / (1 + x); }
     else if (v == "FL_over_F") { const double F = base.Fm + base.FL; p.FL = x * F; p.Fm = F - p.FL; }
-    else throw UsageError("--vary: unknown parameter '" + v + "' (Jm, Fm, JL, FL, K, backlash, reference, JL_over_Jm, FL_over_F)");
+    else if (v == "coulomb_motor") e.coulomb_motor = x;
+    else if (v == "coulomb_load") e.coulomb_load = x;
+    else if (v == "restitution") e.restitution = x;
+    else if (v == "saturation") e.saturation = x;
+    else if (v == "stiffness") e.mesh_stiffness = x;
+    else if (v == "damping") e.mesh_damping = x;
+    else if (v == "delay") e.delay = x;
+    else if (v == "torque_offset") e.torque_offset = x;
+    else throw UsageError("--vary: unknown parameter '" + v + "' (Jm, Fm, JL, FL, K, backlash, reference, JL_over_Jm, FL_over_F, "
+                          "coulomb_motor, coulomb_load, restitution, saturation, stiffness, damping, delay, torque_offset)");
     if (!(p.Jm > 0) || !(p.JL > 0) || p.Fm < 0 || p.FL < 0 || !(p.K > 0) || p.backlash < 0)
       throw UsageError("--from/--to: " + v + " = " + std::to_string(x) + " gives non-physical parameters");
-    points.push_back({spec.id + ":" + v, x, p});
+    if (e.coulomb_motor < 0 || e.coulomb_load < 0 || e.restitution < 0 || e.restitution >= 1 || !(e.saturation > 0) ||
+        !(e.mesh_stiffness > 0) || e.mesh_damping < 0 || e.delay < 0)
+      throw UsageError("--from/--to: " + v + " = " + std::to_string(x) + " is outside the effect's range (docs/effects.md)");
+    if (e.restitution > 0 && e.compliant())
+      throw UsageError("--vary " + v + ": restitution and compliance both model the impact; give one of them");
+    if ((v == "stiffness" || v == "damping") && !e.compliant())
+      throw UsageError("--vary " + v + ": the case has no [effects] compliance to vary (give one in the case file)");
+    points.push_back({spec.id + ":" + v, x, p, e});
   }
   return points;
 }
@@ -90,14 +111,20 @@ void run_sweep_command(const SweepOptions& o) {
   const std::vector<numeric::SweepRow> rows = numeric::run_sweep(points, options, &summary);
   std::ostringstream csv;
   csv.precision(12);
-  csv << "series,x,Jm,Fm,JL,FL,K,backlash,status,branches,peak_to_peak,amplitude,period,separation_velocity,multiplier\n";
+  csv << "series,x,Jm,Fm,JL,FL,K,backlash,effects,status,branches,peak_to_peak,amplitude,period,separation_velocity,multiplier\n";
   for (const numeric::SweepRow& r : rows) {
     const numeric::Parameters& p = r.point.parameters;
+    std::string effects = r.point.effects.describe();
+    std::replace(effects.begin(), effects.end(), ',', ';');  // one CSV cell
+    effects.erase(std::remove(effects.begin(), effects.end(), ' '), effects.end());
     csv << r.point.series << "," << r.point.x << "," << p.Jm << "," << p.Fm << "," << p.JL << "," << p.FL << "," << p.K << ","
-        << p.backlash << "," << r.status << "," << r.branches;
+        << p.backlash << "," << effects << "," << r.status << "," << r.branches;
     if (r.status == "limit_cycle")
-      csv << "," << r.cycle.peak_to_peak << "," << r.cycle.amplitude << "," << r.cycle.period << "," << r.cycle.separation_velocity
-          << "," << r.cycle.multiplier << "\n";
+    {
+      csv << "," << r.cycle.peak_to_peak << "," << r.cycle.amplitude << "," << r.cycle.period << ",";
+      if (std::isfinite(r.cycle.separation_velocity)) csv << r.cycle.separation_velocity;  // none: a pure bounce cycle
+      csv << "," << r.cycle.multiplier << "\n";
+    }
     else
       csv << ",,,,,\n";
   }

@@ -293,27 +293,24 @@ SmallVector ModeFlow::local(double tau) const {
   }
   SmallVector z(4);
   const double vm0 = z0_(1), vL0 = z0_(3);
-  const double y = -b_ * tau, x = -a_ * tau;
-  // load
+  const double y = -b_ * tau, x = -a_ * tau, t2 = tau * tau;
+  const CoupledKernels k = coupled_kernels(x, y);
   if (m.slip_load == 0) {
     z(2) = 0;
     z(3) = 0;
   } else {
-    const double phi1 = phi(1, y);
-    z(2) = vL0 * tau * phi1 + gL_ * tau * tau * phi(2, y);
-    z(3) = vL0 * std::exp(y) + gL_ * tau * phi1;
+    z(2) = vL0 * tau * k.phi1_y + gL_ * t2 * k.phi2_y;
+    z(3) = vL0 * k.exp_y + gL_ * tau * k.phi1_y;
   }
   switch (motor_form_) {
     case 0:
       z(0) = 0;
       z(1) = 0;
       break;
-    case 1: {
-      const double phi1 = phi(1, x);
-      z(0) = vm0 * tau * phi1 + gm_ * tau * tau * phi(2, x);
-      z(1) = vm0 * std::exp(x) + gm_ * tau * phi1;
+    case 1:
+      z(0) = vm0 * tau * k.phi1_x + gm_ * t2 * k.phi2_x;
+      z(1) = vm0 * k.exp_x + gm_ * tau * k.phi1_x;
       break;
-    }
     case 2: {
       const double y0 = measured(p_, start_) - p_.theta_R - y_star_;
       const DampedPair dp = damped_pair(alpha_m_, w2_m_, tau);
@@ -321,14 +318,10 @@ SmallVector ModeFlow::local(double tau) const {
       z(1) = vm0 * dp.c - (alpha_m_ * vm0 + w2_m_ * y0) * dp.s;
       break;
     }
-    default: {
-      const double phi1 = phi(1, x), t2 = tau * tau;
-      const double A1 = exp_divided_difference(1, x, y), A2 = exp_divided_difference(2, x, y),
-                   A3 = exp_divided_difference(3, x, y);
-      z(0) = vm0 * tau * phi1 + c0_ * t2 * phi(2, x) - k_ * vL0 * t2 * tau * A2 - k_ * gL_ * t2 * t2 * A3;
-      z(1) = vm0 * std::exp(x) + c0_ * tau * phi1 - k_ * vL0 * t2 * A1 - k_ * gL_ * t2 * tau * A2;
+    default:
+      z(0) = vm0 * tau * k.phi1_x + c0_ * t2 * k.phi2_x - k_ * vL0 * t2 * tau * k.a2 - k_ * gL_ * t2 * t2 * k.a3;
+      z(1) = vm0 * k.exp_x + c0_ * tau * k.phi1_x - k_ * vL0 * t2 * k.a1 - k_ * gL_ * t2 * tau * k.a2;
       break;
-    }
   }
   return z;
 }

@@ -294,6 +294,7 @@ void describe_cycle(const ValidatedEffectModel& model, const Section& section, c
 std::vector<HybridState> seeds(const ValidatedEffectModel& model, const EffectLimitCycleOptions& o) {
   const Parameters& p = model.parameters();
   std::vector<HybridState> out;
+  if (o.warm_start) out.push_back(*o.warm_start);
   if (std::isfinite(o.step)) out.push_back(effects_step_start(p, model.effects(), o.step));
   const double scale = std::max(1.0, std::fabs(p.theta_R));
   for (double v : o.seed_velocities) {
@@ -336,6 +337,7 @@ LimitCycle find_limit_cycle(const ValidatedEffectModel& model, const EffectLimit
       if (it.converged) {
         cycle.method = "return map (Steffensen iteration)";
         cycle.multiplier = multiplier_at(section, it.state);
+        cycle.section_state = it.state;
         describe_cycle(model, section, it.state, cycle);
       }
     }

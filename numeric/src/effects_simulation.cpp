@@ -51,9 +51,10 @@ double departure_time(const LinearWitness& lw, const SmallVector& zdot0, const s
   const double norm_eAK = eAK.cwiseAbs().sum();
   double tau = horizon;
   for (int i = 0; i < 400 && tau > 0; ++i, tau *= 0.5) {
-    double lower = w[K] * std::pow(tau, K) / factorial(K) -
-                   norm_eAK * std::exp(norm_A * tau) * norm_z * std::pow(tau, K + 1) / factorial(K + 1);
-    for (int j = 0; j < K; ++j) lower -= std::fabs(w[j]) * std::pow(tau, j) / factorial(j);
+    std::array<double, 5> power{1, tau, tau * tau, tau * tau * tau, tau * tau * tau * tau};
+    double lower = w[K] * power[K] / factorial(K) -
+                   norm_eAK * std::exp(norm_A * tau) * norm_z * power[K + 1] / factorial(K + 1);
+    for (int j = 0; j < K; ++j) lower -= std::fabs(w[j]) * power[j] / factorial(j);
     if (lower > 0) return tau;
   }
   return 0;
@@ -109,29 +110,53 @@ bool spurious_separation(const Parameters& p, const ModeFlow& flow, double tau) 
   return std::fabs(z(0)) <= noise && std::fabs(z(1)) <= noise * std::sqrt(p.K / (p.Jm + p.JL));
 }
 
-std::optional<Exit> first_exit(const Parameters& p, const ModeFlow& flow, const Witness& witness, double horizon) {
-  LinearWitness lw;
-  lw.A = flow.segment().A;
-  lw.c = flow.segment().c;
-  lw.e = witness.f.row;
-  lw.level = -witness.f.constant;
-  lw.state = [&flow](double tau) { return flow.local(tau); };
-  lw.third_derivative_bound = flow.derivative_bound(lw.e, 3);
-  const Start start = classify_start(flow, lw, witness.f.magnitude, horizon);
-  if (start.kind == StartKind::Never) return std::nullopt;
-  if (start.kind == StartKind::ExitNow) return Exit{0, witness, false};
-  double from = start.from;
-  while (from < horizon) {
-    const std::optional<Crossing> crossing = first_crossing(lw, from, horizon);
-    if (!crossing) return std::nullopt;
-    const bool skip = (crossing->grazing && !grazing_is_event(witness.guard)) ||
-                      (witness.guard == Guard::ContactTorque && spurious_separation(p, flow, crossing->t));
-    if (!skip) return Exit{crossing->t, witness, crossing->grazing};
-    if (witness.guard == Guard::ContactTorque && !crossing->grazing) return std::nullopt;  // contact holds to the end
-    from = crossing->t + 1e-12 * std::max(1.0, crossing->t);
+// The certified search for one witness's first exit, advanced window by window.
+class ExitSearch {
+ public:
+  ExitSearch(const Parameters& p, const ModeFlow& flow, const Witness& witness, double horizon)
+      : p_(p), flow_(flow), witness_(witness) {
+    lw_.A = flow.segment().A;
+    lw_.c = flow.segment().c;
+    lw_.e = witness.f.row;
+    lw_.level = -witness.f.constant;
+    lw_.state = [&flow](double tau) { return flow.local(tau); };
+    lw_.third_derivative_bound = flow.derivative_bound(lw_.e, 3);
+    const Start start = classify_start(flow, lw_, witness.f.magnitude, horizon);
+    if (start.kind == StartKind::Never) finished_ = true;
+    if (start.kind == StartKind::ExitNow) immediate_ = true;
+    from_ = start.from;
   }
-  return std::nullopt;
-}
+
+  bool immediate() const { return immediate_; }
+
+  /// The first exit in (from, until], or nothing there (the search then resumes at `until`).
+  std::optional<Exit> search_until(double until) {
+    while (!finished_ && from_ < until) {
+      const std::optional<Crossing> crossing = first_crossing(lw_, from_, until);
+      if (!crossing) {
+        from_ = until;
+        return std::nullopt;
+      }
+      const bool spurious = witness_.guard == Guard::ContactTorque && spurious_separation(p_, flow_, crossing->t);
+      if (spurious && !crossing->grazing) {  // the contact motion has decayed to rounding: contact holds to the end
+        finished_ = true;
+        return std::nullopt;
+      }
+      if (!spurious && (!crossing->grazing || grazing_is_event(witness_.guard)))
+        return Exit{crossing->t, witness_, crossing->grazing};
+      from_ = crossing->t + 1e-12 * std::max(1.0, crossing->t);
+    }
+    return std::nullopt;
+  }
+
+ private:
+  const Parameters& p_;
+  const ModeFlow& flow_;
+  Witness witness_;
+  LinearWitness lw_;
+  double from_ = 0;
+  bool finished_ = false, immediate_ = false;
+};
 
 class ClosedFormSegment final : public detail::Segment {
  public:
@@ -142,13 +167,26 @@ class ClosedFormSegment final : public detail::Segment {
       rest = true;  // everything stuck and no delay: the drive cannot change
       return;
     }
+    // Every witness searched window by window, the windows doubling from an eighth of the servo
+    // period: the search stops at the first window that holds an exit, never far beyond it.
+    std::vector<ExitSearch> searches;
     for (const Witness& w : detail::mode_witnesses(p, e, m, functionals_of(p, e, flow_), true)) {
-      std::optional<Exit> candidate = first_exit(p, flow_, w, duration);
-      if (candidate && (!exit || candidate->tau < exit->tau)) {
-        exit = candidate;
-        duration = candidate->tau;
+      searches.emplace_back(p, flow_, w, horizon);
+      if (searches.back().immediate()) {
+        exit = Exit{0, w, false};
+        duration = 0;
+        return;
       }
     }
+    double window = std::min(horizon, 0.125 * servo_period(p));
+    for (double a = 0; a < horizon && !exit; a += window, window *= 2) {
+      const double b = std::min(horizon, a + window);
+      for (ExitSearch& search : searches) {
+        const std::optional<Exit> candidate = search.search_until(exit ? exit->tau : b);
+        if (candidate && (!exit || candidate->tau < exit->tau)) exit = candidate;
+      }
+    }
+    if (exit) duration = exit->tau;
   }
 
   HybridState state(double tau) const override { return flow_.state(tau); }

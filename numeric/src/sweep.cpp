@@ -1,5 +1,6 @@
 #include "backlash/numeric/sweep.hpp"
 
+#include "backlash/numeric/effects_limit_cycle.hpp"
 #include "backlash/numeric/validated_family.hpp"
 
 #include <atomic>
@@ -71,11 +72,12 @@ std::vector<SweepRow> run_sweep(const std::vector<SweepPoint>& points, const Swe
   const int threads = std::max(1, std::min<int>(options.threads, static_cast<int>(points.size())));
   auto work = [&](size_t begin, size_t end) {
     double guess = 0;
+    std::optional<HybridState> warm;
     std::string previous_series;
     for (size_t i = begin; i < end; ++i) {
       SweepRow& row = rows[i];
       row.point = points[i];
-      if (row.point.series != previous_series) guess = 0;
+      if (row.point.series != previous_series) guess = 0, warm.reset();
       previous_series = row.point.series;
       try {
         const std::optional<ValidatedEvaluator> evaluator = family.at(row.point.parameters);
@@ -84,11 +86,24 @@ std::vector<SweepRow> run_sweep(const std::vector<SweepPoint>& points, const Swe
         } else {
           const BranchSelection b = select_branches(row.point.parameters);
           row.branches = std::string(branch_name(b.contact)) + "/" + branch_name(b.free);
-          LimitCycleOptions lc;
-          lc.guess = guess;
-          row.cycle = find_limit_cycle(*evaluator, lc);
-          row.status = row.cycle.status;
-          guess = row.cycle.status == "limit_cycle" ? row.cycle.separation_velocity : 0;
+          if (row.point.effects.any()) {
+            const EffectValidationResult gate = validate_effects(*evaluator, row.point.effects);
+            if (!gate.passed()) {
+              row.status = "unvalidated";
+            } else {
+              EffectLimitCycleOptions lc;
+              lc.warm_start = warm;
+              row.cycle = find_limit_cycle(gate.model(), lc);
+              row.status = row.cycle.status;
+              if (row.cycle.status == "limit_cycle") warm = row.cycle.section_state; else warm.reset();
+            }
+          } else {
+            LimitCycleOptions lc;
+            lc.guess = guess;
+            row.cycle = find_limit_cycle(*evaluator, lc);
+            row.status = row.cycle.status;
+            guess = row.cycle.status == "limit_cycle" ? row.cycle.separation_velocity : 0;
+          }
         }
       } catch (const std::exception& e) {
         row.status = std::string("error: ") + e.what();

@@ -26,6 +26,7 @@
 #include "backlash/numeric/limit_cycle.hpp"
 
 #include <cmath>
+#include <optional>
 #include <vector>
 
 namespace backlash::numeric {
@@ -37,6 +38,7 @@ struct EffectLimitCycleOptions {
   double tolerance = 1e-13;     ///< convergence of the iteration (relative to the section state)
   double horizon = 0;           ///< time allowed for one return (0: 60 slowest time scales, ≥ 100 s)
   bool general = false;         ///< use this method even without effects (tests)
+  std::optional<HybridState> warm_start;  ///< a neighbouring cycle's section state, tried first (sweeps)
 };
 
 LimitCycle find_limit_cycle(const ValidatedEffectModel& model, const EffectLimitCycleOptions& options = {});

@@ -64,6 +64,7 @@ struct LimitCycle {
   double residual = 0;                        ///< |P(s*) − s*| at the fixed point (section coordinates)
   int iterations = 0;                         ///< full cycles iterated before convergence
   double rest_error = 0;                      ///< "none" because the motion stops: θo − θR at rest
+  HybridState section_state;                  ///< the cycle's crossing of the return map's section (warm starts)
 };
 
 struct LimitCycleOptions {

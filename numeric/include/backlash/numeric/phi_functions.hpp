@@ -59,6 +59,14 @@ struct LoadKernels {
 };
 LoadKernels load_kernels(double x, double y);
 
+/// Everything a free flight with constant forcing needs at x = −a·t, y = −b·t (the motor
+/// driven by a load that coasts under a constant torque, effect_modes.hpp), with two libm
+/// calls: e^x, φ1(x), φ2(x), e^y, φ1(y), φ2(y), A1, A2, A3 = exp[0^n, x, y].
+struct CoupledKernels {
+  double exp_x, phi1_x, phi2_x, exp_y, phi1_y, phi2_y, a1, a2, a3;
+};
+CoupledKernels coupled_kernels(double x, double y);
+
 /// e^{-αt}·C(t) and e^{-αt}·S(t) of y'' + 2αy' + w²y = 0 (α ≥ 0, w² ≥ 0):
 ///   y(t)  = y0·c + (ẏ0 + α y0)·s,    ẏ(t) = ẏ0·c − (α ẏ0 + w² y0)·s.
 struct DampedPair {

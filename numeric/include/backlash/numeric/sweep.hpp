@@ -11,9 +11,13 @@
 // every evaluator comes from a ValidatedParametricFamily (validated_family.hpp),
 // validated at `validation_samples` evenly spaced points and at the first point of
 // every further branch the sweep enters.
+// A point with effects has its effect modes validated (effects_simulation.hpp) and its cycle
+// found on the full return map (effects_limit_cycle.hpp), warm-started from its neighbour's
+// crossing of the section.
 // A point's failure is a status in its row, never an exception.
 #pragma once
 
+#include "backlash/numeric/effects.hpp"
 #include "backlash/numeric/limit_cycle.hpp"
 
 #include <functional>
@@ -26,6 +30,7 @@ struct SweepPoint {
   std::string series;  ///< e.g. "JL=Jm"
   double x = 0;        ///< the swept ratio
   Parameters parameters;
+  Effects effects;     ///< the effects at this point (effects_limit_cycle.hpp when any)
 };
 
 struct SweepRow {
