@@ -1,0 +1,192 @@
+// Guarded file access for backlash_measurements (POSIX: open/fstat, mkstemp,
+// fsync, rename).  Every failure is a one-line MeasuredDataError naming the file.
+#include "file_access.hpp"
+
+#include "backlash/measurements/measured_record.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <system_error>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace backlash::measurements::detail {
+
+namespace {
+
+[[noreturn]] void fail(const std::filesystem::path& file, const std::string& problem) {
+  throw MeasuredDataError(file, 0, "", problem);
+}
+
+std::string errno_text(int error_number) { return std::strerror(error_number); }
+
+/// What a non-regular file is, for "not a regular file (…)".
+const char* describe_file_type(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISLNK(mode)) return "a symbolic link";
+  return "not a regular file";
+}
+
+void check_metadata(const std::filesystem::path& file, const struct stat& info, std::uintmax_t max_bytes) {
+  if (S_ISDIR(info.st_mode)) fail(file, "cannot read: it is a directory");
+  if (!S_ISREG(info.st_mode))
+    fail(file, fmt::format("cannot read: not a regular file ({})", describe_file_type(info.st_mode)));
+  const auto size = static_cast<std::uintmax_t>(info.st_size);
+  if (size > max_bytes)
+    fail(file, fmt::format("file too large: {} bytes (the limit is {} bytes)", size, max_bytes));
+}
+
+/// Closes a descriptor when it goes out of scope.
+class Descriptor {
+ public:
+  explicit Descriptor(int fd) : fd_(fd) {}
+  Descriptor(const Descriptor&) = delete;
+  Descriptor& operator=(const Descriptor&) = delete;
+  ~Descriptor() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  int get() const { return fd_; }
+  /// Closes now and reports close()'s own error (0 when fine).
+  int close_now() {
+    const int result = ::close(fd_);
+    fd_ = -1;
+    return result == 0 ? 0 : errno;
+  }
+
+ private:
+  int fd_;
+};
+
+}  // namespace
+
+void require_readable_regular_file(const std::filesystem::path& file, std::uintmax_t max_bytes) {
+  struct stat info {};
+  if (::stat(file.c_str(), &info) != 0) {
+    const int error_number = errno;
+    if (error_number == ENOENT) fail(file, "cannot read: no such file");
+    fail(file, "cannot read: " + errno_text(error_number));
+  }
+  check_metadata(file, info, max_bytes);
+  if (::access(file.c_str(), R_OK) != 0) fail(file, "cannot read: " + errno_text(errno));
+}
+
+std::string read_regular_file(const std::filesystem::path& file, std::uintmax_t max_bytes) {
+  // O_NONBLOCK: opening a FIFO must not wait for a writer; fstat then refuses it.
+  Descriptor fd(::open(file.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK));
+  if (fd.get() < 0) {
+    const int error_number = errno;
+    if (error_number == ENOENT) fail(file, "cannot read: no such file");
+    fail(file, "cannot read: " + errno_text(error_number));
+  }
+  struct stat info {};
+  if (::fstat(fd.get(), &info) != 0) fail(file, "cannot read: " + errno_text(errno));
+  check_metadata(file, info, max_bytes);
+
+  std::string content;
+  content.resize(static_cast<std::size_t>(info.st_size));
+  std::size_t filled = 0;
+  for (;;) {
+    if (filled == content.size()) {
+      // The file may have grown since fstat: keep reading, within the limit.
+      if (content.size() >= max_bytes + 1) break;
+      const std::uintmax_t grown = std::min<std::uintmax_t>(max_bytes + 1, content.size() + 65536);
+      content.resize(static_cast<std::size_t>(grown));
+    }
+    const ssize_t count = ::read(fd.get(), content.data() + filled, content.size() - filled);
+    if (count < 0) {
+      if (errno == EINTR || errno == EAGAIN) continue;
+      fail(file, "cannot read: " + errno_text(errno));
+    }
+    if (count == 0) break;
+    filled += static_cast<std::size_t>(count);
+  }
+  if (filled > max_bytes)
+    fail(file, fmt::format("file too large: more than {} bytes (the limit)", max_bytes));
+  content.resize(filled);
+  return content;
+}
+
+void write_file_atomically(const std::filesystem::path& target, std::string_view content) {
+  if (target.empty()) fail(target, "cannot write: empty file name");
+  if (!target.has_filename() || target.filename() == "." || target.filename() == "..")
+    fail(target, "cannot write: not a file name");
+
+  mode_t mode = 0644;
+  struct stat existing {};
+  if (::lstat(target.c_str(), &existing) == 0) {
+    if (!S_ISREG(existing.st_mode))
+      fail(target, fmt::format("refusing to replace it: not a regular file ({})", describe_file_type(existing.st_mode)));
+    mode = existing.st_mode & 07777;
+  } else if (errno != ENOENT) {
+    fail(target, "cannot write: " + errno_text(errno));
+  }
+
+  const std::filesystem::path directory = target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+  struct stat directory_info {};
+  if (::stat(directory.c_str(), &directory_info) != 0) {
+    const int error_number = errno;
+    if (error_number == ENOENT) fail(target, "cannot write: directory " + directory.string() + " does not exist");
+    fail(target, "cannot write: " + errno_text(error_number));
+  }
+  if (!S_ISDIR(directory_info.st_mode)) fail(target, "cannot write: " + directory.string() + " is not a directory");
+
+  std::string temporary = (directory / fmt::format(".{}.tmp-XXXXXX", target.filename().string())).string();
+  Descriptor fd(::mkostemp(temporary.data(), O_CLOEXEC));
+  if (fd.get() < 0) fail(target, "cannot write: cannot create a temporary file: " + errno_text(errno));
+
+  auto give_up = [&](const std::string& problem) {
+    ::unlink(temporary.c_str());
+    fail(target, "cannot write: " + problem);
+  };
+
+  std::size_t written = 0;
+  while (written < content.size()) {
+    const ssize_t count = ::write(fd.get(), content.data() + written, content.size() - written);
+    if (count < 0) {
+      if (errno == EINTR) continue;
+      give_up(errno_text(errno));
+    }
+    written += static_cast<std::size_t>(count);
+  }
+  if (::fchmod(fd.get(), mode) != 0) give_up(errno_text(errno));
+  if (::fsync(fd.get()) != 0) give_up(errno_text(errno));
+  if (const int close_error = fd.close_now(); close_error != 0) give_up(errno_text(close_error));
+  if (::rename(temporary.c_str(), target.c_str()) != 0) give_up(errno_text(errno));
+}
+
+std::string printable(std::string_view text, std::size_t max_characters) {
+  std::string out;
+  std::size_t shown = 0;
+  for (const char character : text) {
+    if (shown == max_characters) {
+      out += "...";
+      break;
+    }
+    const auto byte = static_cast<unsigned char>(character);
+    if (byte < 0x20 || byte >= 0x7F || character == '\'' || character == '\\')
+      out += fmt::format("\\x{:02X}", byte);
+    else
+      out += character;
+    ++shown;
+  }
+  return out;
+}
+
+std::string quoted(std::string_view text, std::size_t max_characters) {
+  return fmt::format("'{}'", printable(text, max_characters));
+}
+
+std::string shortest(double value) { return fmt::format("{}", value); }
+
+}  // namespace backlash::measurements::detail
