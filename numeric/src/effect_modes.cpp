@@ -398,6 +398,12 @@ ModeFlow::Functional ModeFlow::gap_functional() const {
   f.row(2) = 1;
   f.constant = start_.theta_L - start_.theta_m;
   f.magnitude = std::fabs(start_.theta_L) + std::fabs(start_.theta_m);
+  // A flight that starts on a face (after a separation or an impact, placed there exactly)
+  // starts exactly at ±b/2: its gap is not the rounding of θL − θm, which would put a
+  // millionth of a tiny bounce's height into the constant.
+  for (int face : {-1, 1})
+    if (std::fabs(f.constant - face * p_.backlash / 2) <= 8 * std::numeric_limits<double>::epsilon() * f.magnitude)
+      f.constant = face * p_.backlash / 2;
   return f;
 }
 

@@ -61,6 +61,8 @@ double drive_torque(const Parameters& p, const Effects& e, double theta_o_fed_ba
 
 double servo_period(const Parameters& p) { return 2 * M_PI * std::sqrt((p.Jm + p.JL) / p.K); }
 
+double slowest_bounce(const Parameters& p) { return 1e-9 * std::sqrt(p.K / (p.Jm + p.JL)) * std::max(1.0, p.backlash); }
+
 HybridState effects_step_start(const Parameters& p, const Effects& e, double step) {
   HybridState s = state_on_face(p, step >= 0 ? -1 : +1, p.theta_R - step, 0, true);
   s.drive_regime = drive_regime(p, e, p.theta_R - step);

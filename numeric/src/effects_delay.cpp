@@ -34,7 +34,7 @@ namespace {
 
 namespace odeint = boost::numeric::odeint;
 
-constexpr double tolerance = 1e-11;  // dopri5 absolute = relative error per step
+constexpr double tolerance = 1e-13;  // dopri5 absolute = relative error per step (1e-11 drifted 1e-10 s per s)
 constexpr int samples_per_step = 6;  // witness samples inside each step (plus its end)
 
 struct Jet {
@@ -117,6 +117,11 @@ class DelayLine {
 
   /// The times where the delayed demand crosses ±L, with the regime after each.
   const std::map<double, int>& regime_changes() const { return changes_; }
+  /// The first such time after t (infinity if none is known yet: the history may add some).
+  double next_change_after(double t) const {
+    const auto c = changes_.upper_bound(t + 1e-12 * std::max(1.0, std::fabs(t)));
+    return c == changes_.end() ? INFINITY : c->first;
+  }
 
  private:
   // θo crossing θR ∓ L/K at s makes the demand at s + τ cross ±L.
@@ -232,6 +237,9 @@ class DelayedSegment final : public Segment {
       f.row(2) = 1;
       f.constant = start_.theta_L - start_.theta_m;
       f.magnitude = std::fabs(start_.theta_L) + std::fabs(start_.theta_m);
+      for (int face : {-1, 1})  // a flight placed on a face starts exactly there (effect_modes.cpp)
+        if (std::fabs(f.constant - face * p_.backlash / 2) <= 8 * std::numeric_limits<double>::epsilon() * f.magnitude)
+          f.constant = face * p_.backlash / 2;
     }
     return f;
   }
@@ -245,7 +253,9 @@ class DelayedSegment final : public Segment {
   }
 
   double witness_value(const Witness& w, const SmallVector& z, double t) const {
-    return w.f.row.dot(z) + w.f.constant + (w.f.drive_weight != 0 ? w.f.drive_weight * line_.drive(t).value : 0.0);
+    double sum = w.f.constant;
+    for (int i = 0; i < n_; ++i) sum += w.f.row(i) * z(i);
+    return w.f.drive_weight != 0 ? sum + w.f.drive_weight * line_.drive(t).value : sum;
   }
 
   SmallVector z_at(double t) const {
@@ -281,25 +291,29 @@ class DelayedSegment final : public Segment {
     return {measured(p_, start_) + z(i), z1(i), z2(i)};
   }
 
-  // Whether each witness is armed at the start (valid side), exits at once, or waits until it
-  // is clearly inside (it starts on its boundary moving inward).
-  enum class Arming { Armed, ExitNow, Waiting };
+  // Whether each witness is armed at the start (valid side), exits at once, departs from its
+  // boundary inward with a non-zero rate (armed from its first positive sample: a tiny
+  // bounce's return is an event however small), or waits until it is clearly inside.
+  enum class Arming { Armed, ExitNow, Departing, Waiting };
   Arming arm(const Witness& w, double& tolerance_out) const {
     const auto [z1, z2] = derivatives(sys_.z0, t0_);
     const Jet d = line_.drive(t0_);
     const double w0 = witness_value(w, sys_.z0, t0_);
-    const double tol = 1e-11 * (w.f.row.cwiseAbs().dot(sys_.z0.cwiseAbs().transpose()) + w.f.magnitude +
-                                std::fabs(w.f.drive_weight * d.value)) +
-                       32 * w.f.row.cwiseAbs().dot(sys_.z0_noise.transpose());
+    const double w1 = w.f.row.dot(z1) + w.f.drive_weight * d.rate;
+    // On the boundary: within the rounding of its terms, or what the previous event's time
+    // tolerance moves it (as the closed-form engine, effects_simulation.cpp).
+    const double tol = 64 * std::numeric_limits<double>::epsilon() *
+                           (w.f.row.cwiseAbs().dot(sys_.z0.cwiseAbs().transpose()) + w.f.magnitude +
+                            std::fabs(w.f.drive_weight * d.value)) +
+                       32 * w.f.row.cwiseAbs().dot(sys_.z0_noise.transpose()) + std::fabs(w1) * 4e-14 * std::max(1.0, t0_);
     tolerance_out = tol;
     if (w0 > tol) return Arming::Armed;
     if (w0 < -tol) return Arming::ExitNow;
-    const double w1 = w.f.row.dot(z1) + w.f.drive_weight * d.rate;
     const double s1 = w.f.row.cwiseAbs().dot((sys_.segment.A.cwiseAbs() * (sys_.z0.cwiseAbs() + sys_.z0_noise) +
                                               sys_.c_magnitude + sys_.drive_column.cwiseAbs() * std::fabs(d.value))
                                                  .transpose()) +
                       std::fabs(w.f.drive_weight * d.rate);
-    if (std::fabs(w1) > 1e-9 * s1) return w1 < 0 ? Arming::ExitNow : Arming::Waiting;
+    if (std::fabs(w1) > 1e-9 * s1) return w1 < 0 ? Arming::ExitNow : Arming::Departing;
     const double w2 = w.f.row.dot(z2) + w.f.drive_weight * d.acceleration;
     if (w2 < 0 && std::fabs(w2) > 1e-9 * (s1 + std::fabs(w.f.drive_weight * d.acceleration))) return Arming::ExitNow;
     return Arming::Waiting;
@@ -363,39 +377,60 @@ class DelayedSegment final : public Segment {
     auto stepper = odeint::make_controlled(tolerance, tolerance, odeint::runge_kutta_dopri5<Vector>());
     Vector x{};
     for (int i = 0; i < n_; ++i) x[i] = sys_.z0(i);
-    double t = t0_, dt = std::min(dt_max, std::max(1e-6, 1e-3 * dt_max));
     SmallVector za = sys_.z0;
-    auto [za1, za2] = derivatives(za, t);
+    auto [za1, za2] = derivatives(za, t0_);
+    // A witness that leaves its boundary inward but curves back (w' > 0 > w'') returns after
+    // about 2w'/|w''|: the first step is kept well below that, so its samples see the flight.
+    double dt = std::min(dt_max, std::max(1e-6, 1e-3 * dt_max));
+    for (std::size_t i = 0; i < witnesses_.size(); ++i) {
+      if (arming[i] != Arming::Departing && arming[i] != Arming::Waiting) continue;
+      double w1 = witnesses_[i].f.drive_weight * line_.drive(t0_).rate, w2 = witnesses_[i].f.drive_weight * line_.drive(t0_).acceleration;
+      for (int j = 0; j < n_; ++j) w1 += witnesses_[i].f.row(j) * za1(j), w2 += witnesses_[i].f.row(j) * za2(j);
+      if (w1 > 0 && w2 < 0) dt = std::min(dt, 0.25 * w1 / -w2);
+    }
+    double t = t0_;
     while (t < stop && !exit) {
       const double ta = t;
-      double trial = std::min({dt, dt_max, stop - t});
-      if (stop - t - trial < 1e-12 * std::max(1.0, stop)) trial = stop - t;
+      // Stop on a change of the delayed drive's regime the history has just revealed.
+      const double end = std::min(stop, line_.next_change_after(t));
+      double trial = std::min({dt, dt_max, end - t});
+      if (end - t - trial < 1e-12 * std::max(1.0, end)) trial = end - t;
       if (stepper.try_step(rhs, x, t, trial) != odeint::success) {
         dt = trial;
         continue;
       }
       dt = trial;  // the stepper proposes the next step in `trial`
-      if (t > stop || stop - t < 1e-12 * std::max(1.0, stop)) t = stop;
+      if (t > end || end - t < 1e-12 * std::max(1.0, end)) t = end;
       SmallVector zb(n_);
       for (int i = 0; i < n_; ++i) zb(i) = x[i];
       const auto [zb1, zb2] = derivatives(zb, t);
       Step step{ta, t, {}};
       for (int i = 0; i < n_; ++i) step.z[i] = Quintic(ta, t, {za(i), za1(i), za2(i)}, {zb(i), zb1(i), zb2(i)});
       steps_.push_back(step);
-      const double end = check_step(steps_.back(), arming, tolerances);
+      const double kept_until = check_step(steps_.back(), arming, tolerances);
       const Step& kept = steps_.back();
       SmallVector ze(n_), ze1(n_), ze2(n_);
       for (int i = 0; i < n_; ++i) {
-        const Jet j = kept.z[i].at(end);
+        const Jet j = kept.z[i].at(kept_until);
         ze(i) = j.value;
         ze1(i) = j.rate;
         ze2(i) = j.acceleration;
       }
-      line_.append(ta, end, theta_o_jet(za, za1, za2), theta_o_jet(ze, ze1, ze2));
+      line_.append(ta, kept_until, theta_o_jet(za, za1, za2), theta_o_jet(ze, ze1, ze2));
       za = zb;
       za1 = zb1;
       za2 = zb2;
+      if (!exit && t == end && end < stop) regime_change(end);
     }
+  }
+
+  // The delayed drive enters or leaves its limit at t: an exit of this segment.
+  void regime_change(double t) {
+    const auto change = line_.regime_changes().find(t);
+    if (change == line_.regime_changes().end()) return;
+    const int regime = change->second;
+    const Guard guard = regime > 0 ? Guard::DriveHigh : regime < 0 ? Guard::DriveLow : Guard::DriveLeave;
+    exit = Exit{t - t0_, Witness{guard, 0, Functional{SmallRow::Zero(n_), 0, 0, 0}}, false};
   }
 
   // Witness exits inside a step, on its interpolant; returns the end of the step that is kept.
@@ -423,7 +458,8 @@ class DelayedSegment final : public Segment {
           const double t = 0.5 * (r.first + r.second);
           if (!first || t - t0_ < first->tau) first = Exit{t - t0_, w, false};
         }
-        if (arming[i] == Arming::Waiting && wb > tolerances[i]) arming[i] = Arming::Armed;
+        if ((arming[i] == Arming::Waiting && wb > tolerances[i]) || (arming[i] == Arming::Departing && wb > 0))
+          arming[i] = Arming::Armed;
         wa[i] = wb;
       }
       if (first) {
@@ -443,12 +479,8 @@ class DelayedSegment final : public Segment {
     }
     duration = stop - t0_;
     if (rest) return;
-    const auto change = line_.regime_changes().find(stop);
-    if (change != line_.regime_changes().end() && duration < std::numeric_limits<double>::infinity()) {
-      const int regime = change->second;
-      const Guard guard = regime > 0 ? Guard::DriveHigh : regime < 0 ? Guard::DriveLow : Guard::DriveLeave;
-      exit = Exit{duration, Witness{guard, 0, Functional{SmallRow::Zero(n_), 0, 0, 0}}, false};
-    }
+    regime_change(stop);
+    if (exit) duration = exit->tau;
   }
 
   void include(const HybridState& h, Extremes& x) const {

@@ -292,30 +292,41 @@ void Engine::impact(const Exit& exit) {
   const HybridState before = state_;
   const int face_hit = exit.witness.face;
   const EventKind kind = exit.witness.guard == Guard::GapOpposite ? EventKind::Recombination : EventKind::Recontact;
-  const ImpactVelocities v = impact_velocities(p_, e_.restitution, before.dtheta_m, before.dtheta_L);
+  // Restitution applies above the slowest bounce; a slower impact is inelastic (effects.md).
+  const bool bounces = e_.restitution > 0 && std::fabs(before.dtheta_L - before.dtheta_m) >= slowest_bounce(p_);
+  const ImpactVelocities v = impact_velocities(p_, bounces ? e_.restitution : 0.0, before.dtheta_m, before.dtheta_L);
   HybridState after = state_on_face(p_, face_hit, measured(p_, before), v.dtheta_m, true);
   after.dtheta_L = v.dtheta_L;
   after.drive_regime = before.drive_regime;
   state_ = after;
   bool converging = false;
-  if (e_.restitution == 0) {
+  if (!bounces) {
     const bool holds = contact_holds(state_);
     if (!holds) state_.in_contact = false;
     push(kind, Body::None, !holds, exit.grazing);
     result_.events.back().before = before;
   } else {
+    // A bounce series continues when the event before this impact was a bounce on this face:
+    // only then is the impact exempt from the chattering guard (a stick-bounce cascade is not).
+    const auto& events = result_.events;
+    const bool continues_series = !events.empty() && events.back().bounce &&
+                                  (events.back().kind == EventKind::Recombination ||
+                                   events.back().kind == EventKind::Recontact) &&
+                                  events.back().after.face == face_hit;
     state_.in_contact = false;
     push(kind, Body::None, true, exit.grazing);
     result_.events.back().before = before;
     const double alpha = closing_acceleration(face_hit);
-    converging = alpha > 0;  // impacts of a converging series are not chattering
+    converging = alpha > 0 && continues_series;
     if (accumulate(face_hit, alpha, before)) push(EventKind::Recontact, Body::None, false, false, true);
   }
-  if (!converging) {
-    impacts_.push_back(t_);
-    while (!impacts_.empty() && impacts_.front() < t_ - o_.zeno_window) impacts_.pop_front();
-  }
+  if (!converging) count_impact();
   settle();
+}
+
+void Engine::count_impact() {
+  impacts_.push_back(t_);
+  while (!impacts_.empty() && impacts_.front() < t_ - o_.zeno_window) impacts_.pop_front();
 }
 
 void Engine::transition(const Exit& exit, const Mode& m) {
@@ -375,6 +386,7 @@ void Engine::transition(const Exit& exit, const Mode& m) {
       state_.in_contact = true;
       state_.face = exit.witness.face;
       push(exit.witness.face == m.face ? EventKind::Recontact : EventKind::Recombination);
+      count_impact();  // engagements count towards the chattering guard like impacts
       break;
     case Guard::ZoneExit:
       break;  // the teeth no longer overlap: the engagement guard changes, nothing happens

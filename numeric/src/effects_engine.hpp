@@ -128,6 +128,7 @@ class Engine {
   void settle_body(bool motor);
   void transition(const Exit& exit, const Mode& m);
   void impact(const Exit& exit);
+  void count_impact();
   double closing_acceleration(int face) const;
   bool accumulate(int face, double alpha, const HybridState& before);
   bool contact_holds(const HybridState& s) const;

@@ -67,11 +67,13 @@ struct Start {
 };
 
 // Where the search for a witness's exit starts.  Rounding scales come from the size of the
-// terms that formed each quantity (a deviation or a forcing can cancel): w(0) is on the
-// boundary within 1e-11 of its terms' size, a derivative is noise below 1e-9 of its terms'.
+// terms that formed each quantity (a deviation or a forcing can cancel): w(0) is on its
+// boundary when within the rounding of its terms, or within what the previous event's time
+// tolerance (toms748: 1e-14 of t) moves it; a derivative is noise below 1e-9 of its terms'.
+// (A looser on-boundary rule — 1e-11 of the terms — took a real 1e-11 gap for a contact.)
 // On the boundary, the first derivative that is not noise decides: leaving the valid side is
 // an exit at once, entering it starts the search after a certified departure time.
-Start classify_start(const ModeFlow& flow, const LinearWitness& lw, double magnitude, double horizon) {
+Start classify_start(const ModeFlow& flow, const LinearWitness& lw, double magnitude, double horizon, double t_global) {
   const SmallVector& z0 = flow.local_start();
   const SmallVector& z0_noise = flow.local_start_noise();
   const SmallVector zdot = lw.A * z0 + lw.c;
@@ -79,14 +81,16 @@ Start classify_start(const ModeFlow& flow, const LinearWitness& lw, double magni
   std::array<double, 4> w{};
   std::array<double, 4> scale{};
   w[0] = lw.e.dot(z0) - lw.level;
-  const double tolerance = 1e-11 * (lw.e.cwiseAbs().dot(z0.cwiseAbs().transpose()) + magnitude) +
-                           32 * lw.e.cwiseAbs().dot(z0_noise.transpose());
   SmallRow e = lw.e;
   for (int k = 1; k <= 3; ++k) {
     w[k] = e.dot(zdot);
     scale[k] = e.cwiseAbs().dot(zdot_scale.transpose());
     e = e * lw.A;
   }
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  const double tolerance = 64 * eps * (lw.e.cwiseAbs().dot(z0.cwiseAbs().transpose()) + magnitude) +
+                           32 * lw.e.cwiseAbs().dot(z0_noise.transpose()) +
+                           std::fabs(w[1]) * 4e-14 * std::max(1.0, std::fabs(t_global));
   if (w[0] > tolerance) return {StartKind::Inside, 0};
   if (w[0] < -tolerance) return {StartKind::ExitNow, 0};
   for (int K = 1; K <= 3; ++K) {
@@ -113,7 +117,7 @@ bool spurious_separation(const Parameters& p, const ModeFlow& flow, double tau) 
 // The certified search for one witness's first exit, advanced window by window.
 class ExitSearch {
  public:
-  ExitSearch(const Parameters& p, const ModeFlow& flow, const Witness& witness, double horizon)
+  ExitSearch(const Parameters& p, const ModeFlow& flow, const Witness& witness, double horizon, double t_global)
       : p_(p), flow_(flow), witness_(witness) {
     lw_.A = flow.segment().A;
     lw_.c = flow.segment().c;
@@ -121,7 +125,7 @@ class ExitSearch {
     lw_.level = -witness.f.constant;
     lw_.state = [&flow](double tau) { return flow.local(tau); };
     lw_.third_derivative_bound = flow.derivative_bound(lw_.e, 3);
-    const Start start = classify_start(flow, lw_, witness.f.magnitude, horizon);
+    const Start start = classify_start(flow, lw_, witness.f.magnitude, horizon, t_global);
     if (start.kind == StartKind::Never) finished_ = true;
     if (start.kind == StartKind::ExitNow) immediate_ = true;
     from_ = start.from;
@@ -160,7 +164,8 @@ class ExitSearch {
 
 class ClosedFormSegment final : public detail::Segment {
  public:
-  ClosedFormSegment(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start, double horizon)
+  ClosedFormSegment(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start, double horizon,
+                    double t_global)
       : params_(p), flow_(p, e, m, start) {
     duration = horizon;
     if (m.kind == ModeKind::Contact ? m.slip_motor == 0 : (m.slip_motor == 0 && m.slip_load == 0)) {
@@ -171,7 +176,7 @@ class ClosedFormSegment final : public detail::Segment {
     // period: the search stops at the first window that holds an exit, never far beyond it.
     std::vector<ExitSearch> searches;
     for (const Witness& w : detail::mode_witnesses(p, e, m, functionals_of(p, e, flow_), true)) {
-      searches.emplace_back(p, flow_, w, horizon);
+      searches.emplace_back(p, flow_, w, horizon, t_global);
       if (searches.back().immediate()) {
         exit = Exit{0, w, false};
         duration = 0;
@@ -240,7 +245,7 @@ class ClosedFormEngine final : public detail::Engine {
     return drive_torque_in_regime(p_, e_, measured(p_, state_), state_.drive_regime);
   }
   std::unique_ptr<detail::Segment> next_segment(const Mode& mode, double remaining) override {
-    return std::make_unique<ClosedFormSegment>(p_, e_, mode, state_, remaining);
+    return std::make_unique<ClosedFormSegment>(p_, e_, mode, state_, remaining, t_);
   }
 };
 

@@ -117,4 +117,71 @@ EffectValidationResult validate_effects(const ValidatedEvaluator& nominal, const
   return result;
 }
 
+std::string ValidatedModelFamily::structure(const Effects& e) {
+  std::string key;
+  key += e.coulomb_motor > 0 ? 'm' : '-';
+  key += e.coulomb_load > 0 ? 'l' : '-';
+  key += e.restitution > 0 ? 'e' : '-';
+  key += e.saturating() ? 's' : '-';
+  key += e.compliant() ? 'k' : '-';
+  key += e.delayed() ? 'd' : '-';
+  key += e.torque_offset != 0 ? 'o' : '-';
+  return key;
+}
+
+std::vector<double> ValidatedModelFamily::coordinates(const Parameters& p, const Effects& e) {
+  return {p.Jm, p.Fm, p.JL, p.FL, p.K, p.theta_R, p.backlash, e.coulomb_motor, e.coulomb_load, e.restitution,
+          e.saturating() ? e.saturation : 0.0, e.compliant() ? e.mesh_stiffness : 0.0, e.mesh_damping, e.delay,
+          e.torque_offset, p.measured_at == model::MeasuredAt::Motor ? 1.0 : 0.0};
+}
+
+bool ValidatedModelFamily::validate_samples(const std::vector<std::pair<Parameters, Effects>>& samples) {
+  bool all = true;
+  for (const auto& [p, e] : samples) {
+    const std::string key = structure(e);
+    const std::optional<ValidatedEvaluator> nominal = nominal_.at(p);
+    const bool passed = nominal && validate_effects(*nominal, e, options_).passed();
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++validated_;
+    if (!passed) {
+      failed_.insert(key);
+      all = false;
+      continue;
+    }
+    const std::vector<double> x = coordinates(p, e);
+    auto [it, inserted] = boxes_.try_emplace(key, Box{x, x});
+    if (!inserted)
+      for (std::size_t i = 0; i < x.size(); ++i) {
+        it->second.low[i] = std::min(it->second.low[i], x[i]);
+        it->second.high[i] = std::max(it->second.high[i], x[i]);
+      }
+  }
+  return all;
+}
+
+std::optional<ValidatedEffectModel> ValidatedModelFamily::at(const Parameters& p, const Effects& e) {
+  const std::string key = structure(e);
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (failed_.count(key)) return std::nullopt;
+    const auto box = boxes_.find(key);
+    if (box == boxes_.end()) return std::nullopt;
+    const std::vector<double> x = coordinates(p, e);
+    for (std::size_t i = 0; i < x.size(); ++i)
+      if (!(x[i] >= box->second.low[i] && x[i] <= box->second.high[i])) return std::nullopt;
+  }
+  std::optional<ValidatedEvaluator> nominal = nominal_.at(p);
+  if (!nominal) return std::nullopt;
+  EffectValidationReport report;
+  report.effects = e;
+  report.tolerance = options_.tolerance;
+  report.passed = true;
+  return ValidatedEffectModel(std::move(*nominal), e, std::move(report));
+}
+
+long ValidatedModelFamily::samples_validated() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return validated_;
+}
+
 }  // namespace backlash::numeric

@@ -73,7 +73,8 @@
 //     the other face (recombination) — the rigid drive's torque reversal, with no
 //     change of velocity.  (Witnesses unarmed at 0 that go negative fire at the start.)
 //  6. Mesh engagements count towards the chattering guard like impacts; impacts of a
-//     converging bounce series (e > 0, α > 0) do not.
+//     converging bounce series (e > 0, α > 0, the previous event a bounce on the same face)
+//     do not.
 //  7. The nominal rest rule (velocities below rest_velocity at t_end, no further event)
 //     applies to free flight only, as in the nominal simulators.
 //  8. The rounding-level rule of the nominal simulators (a zero of Tc where the contact
@@ -1087,7 +1088,10 @@ std::optional<SimulationStatus> Simulator::impact(int face_hit, EventKind kind) 
   const int regime = st_.drive_regime;
   on_face(face_hit);
 
-  if (m_.e > 0 && v_rel != 0) {
+  // Restitution applies above the slowest bounce, 1e-9·sqrt(K/J)·max(1, b) of relative velocity;
+  // a slower impact is inelastic (docs/effects.md: it ends a stick–bounce cascade).
+  const double slowest = 1e-9 * std::sqrt(m_.p.K / J) * std::max(1.0, m_.p.backlash);
+  if (m_.e > 0 && std::fabs(v_rel) >= slowest) {
     const double v_rel_after = -m_.e * v_rel;
     const double vm_after = V - JL / J * v_rel_after, vL_after = V + Jm / J * v_rel_after;
     st_ = state_on_face(m_.p, face_hit, theta_o, 0, false);
@@ -1103,6 +1107,12 @@ std::optional<SimulationStatus> Simulator::impact(int face_hit, EventKind kind) 
     const double aL = (-m_.p.FL * vL_after - m_.TL * sL) / JL;
     const double alpha = face_hit * (aL - am);
     const double w = m_.e * std::fabs(v_rel);
+    // A bounce series continues when the event before this impact was a bounce on this face;
+    // only then are its impacts exempt from the chattering guard (a stick-bounce cascade is not).
+    const bool continues_series = !result_.events.empty() && result_.events.back().bounce &&
+                                  (result_.events.back().kind == EventKind::Recombination ||
+                                   result_.events.back().kind == EventKind::Recontact) &&
+                                  result_.events.back().after.face == face_hit;
     const bool converging = alpha > 0;
     push_event(kind, true);
     if (converging) {
@@ -1125,9 +1135,8 @@ std::optional<SimulationStatus> Simulator::impact(int face_hit, EventKind kind) 
         if (omega_after == 0) return settle();
         return std::nullopt;
       }
-    } else if (count_impact()) {
-      return SimulationStatus::Chattering;
     }
+    if (!(converging && continues_series) && count_impact()) return SimulationStatus::Chattering;
     s_m_ = sgn(vm_after);
     s_L_ = sgn(vL_after);
     return settle();

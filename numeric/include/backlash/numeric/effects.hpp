@@ -57,6 +57,11 @@ double drive_torque_in_regime(const Parameters& p, const Effects& e, double thet
 /// The servo period 2π·sqrt(J/K), the time scale of the accumulation rule.
 double servo_period(const Parameters& p);
 
+/// The slowest impact that bounces (docs/effects.md): 1e-9·sqrt(K/J)·max(1, b) [rad/s] of
+/// relative velocity.  A slower impact is inelastic — its bounce would be w²/α high, below
+/// the resolution of the positions — which ends a stick–bounce cascade as it accumulates.
+double slowest_bounce(const Parameters& p);
+
 /// The step start with effects: at rest, θo = θR − step, in contact (rigid, or the mesh
 /// engaged at zero penetration) on the face that drives toward θR; the drive's regime from
 /// the initial error.  Sticking is not decided here: each simulator applies the static

@@ -28,9 +28,13 @@
 #include "backlash/numeric/effect_modes.hpp"
 #include "backlash/numeric/effects.hpp"
 #include "backlash/numeric/hybrid_simulation.hpp"
+#include "backlash/numeric/validated_family.hpp"
 #include "backlash/numeric/validation.hpp"
 
+#include <map>
+#include <mutex>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -64,6 +68,7 @@ struct EffectValidationReport {
 };
 
 class EffectValidationResult;
+class ValidatedModelFamily;
 
 /// A model with effects whose nominal evaluator and effect-mode flows passed their gates.
 class ValidatedEffectModel {
@@ -76,6 +81,7 @@ class ValidatedEffectModel {
  private:
   friend EffectValidationResult validate_effects(const ValidatedEvaluator& nominal, const Effects& effects,
                                                  const EffectValidationOptions& options);
+  friend class ValidatedModelFamily;
   ValidatedEffectModel(ValidatedEvaluator nominal, Effects effects, EffectValidationReport report)
       : nominal_(std::move(nominal)), effects_(effects), report_(std::move(report)) {}
   ValidatedEvaluator nominal_;
@@ -100,6 +106,34 @@ class EffectValidationResult {
 /// The effects gate.  Never throws for a failing flow: the result says so.
 EffectValidationResult validate_effects(const ValidatedEvaluator& nominal, const Effects& effects,
                                         const EffectValidationOptions& options = {});
+
+/// The gate for a family of models (fits over parameters, sweeps): the nominal evaluator
+/// validated per pole-structure branch (validated_family.hpp), the effect modes validated at
+/// sample points.  A model is handed out only when its nominal branches passed and its effects'
+/// structure (which effects are present) was validated at samples whose box — each parameter
+/// between the smallest and largest sampled value — contains it.  Thread-safe.
+class ValidatedModelFamily {
+ public:
+  explicit ValidatedModelFamily(EffectValidationOptions options = {}) : options_(options) {}
+  /// Validates each sample (nominal and effect modes); false if any failed.
+  bool validate_samples(const std::vector<std::pair<Parameters, Effects>>& samples);
+  /// A validated model for (p, e), or nothing (outside every validated box, or a failed sample).
+  std::optional<ValidatedEffectModel> at(const Parameters& p, const Effects& e);
+  long samples_validated() const;
+
+ private:
+  struct Box {
+    std::vector<double> low, high;
+  };
+  static std::string structure(const Effects& e);
+  static std::vector<double> coordinates(const Parameters& p, const Effects& e);
+  ValidatedParametricFamily nominal_;
+  EffectValidationOptions options_;
+  mutable std::mutex mutex_;
+  std::map<std::string, Box> boxes_;
+  std::set<std::string> failed_;
+  long validated_ = 0;
+};
 
 /// The accumulation threshold of docs/effects.md: a bounce series whose remaining duration is
 /// below this fraction of the servo period is summed, not simulated.

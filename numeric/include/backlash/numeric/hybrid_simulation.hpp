@@ -68,6 +68,9 @@ const char* to_string(SimulationStatus status);
 struct SimulationOptions {
   double t_end = 60;
   double sample_interval = 0;   ///< > 0: record the trajectory every sample_interval (for CSV)
+  /// Non-empty: record the trajectory at these times instead (ascending; a measured record's
+  /// own grid; times before 0 give the start state, the system at rest before the step).
+  std::vector<double> sample_times;
   long max_events = 100000;
   double rest_velocity = 1e-9;  ///< rest when every velocity is below this (and no event can follow)
   int zeno_impacts = 100;       ///< chattering when this many impacts happen within zeno_window
@@ -117,20 +120,28 @@ class TrajectoryRecorder {
   /// Samples at the global times ≤ t_upto of a segment that starts at t0; `at(τ)` is its state at τ = t − t0.
   template <class At>
   void record(double t0, double t_upto, const At& at) {
+    if (!o_.sample_times.empty()) {
+      const std::vector<double>& times = o_.sample_times;
+      for (; index_ < times.size() && times[index_] <= t_upto; ++index_) push(times[index_], at(std::max(0.0, times[index_] - t0)));
+      return;
+    }
     if (o_.sample_interval <= 0) return;
     while (next_ <= t_upto) {
-      const HybridState h = at(next_ - t0);
-      r_.samples.push_back({next_, measured(p_, h), measured_velocity(p_, h), h.theta_m, h.dtheta_m, h.theta_L,
-                            h.dtheta_L, h.in_contact});
+      push(next_, at(next_ - t0));
       next_ += o_.sample_interval;
     }
   }
 
  private:
+  void push(double t, const HybridState& h) {
+    r_.samples.push_back({t, measured(p_, h), measured_velocity(p_, h), h.theta_m, h.dtheta_m, h.theta_L, h.dtheta_L,
+                          h.in_contact});
+  }
   const Parameters& p_;
   const SimulationOptions& o_;
   SimulationResult& r_;
   double next_ = 0;
+  std::size_t index_ = 0;
 };
 
 /// The state with the measured shaft at θo, both shafts moving at `velocity`, and the

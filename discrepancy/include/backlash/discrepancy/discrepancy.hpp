@@ -1,0 +1,142 @@
+// backlash/discrepancy/discrepancy.hpp — where a simulation and a measurement
+// disagree, which effect the model is missing, how big it is, and the model
+// corrected (docs/discrepancy.md).
+//
+// Given a nominal model (a case file, possibly with effects already in it) and a
+// measured step response (the project's CSV: t, theta_out [, theta_motor,
+// theta_load]), the workflow
+//   1. simulates the model on the record's own time grid and estimates the noise of
+//      theta_out from the record alone: σ = MAD(Δ⁴y)/(0.6745·√70) — the fourth
+//      difference removes any smooth motion, and a few kinks (impacts) do not move
+//      a median;
+//   2. localises the disagreement: the residual per region between the simulated
+//      events (contact, free flight, mesh, rest), the first time it leaves the
+//      noise band (|r| > 3σ over 5 consecutive samples), and features of the
+//      record against the model (overshoot, final error, decay rate, cycle
+//      amplitude and period);
+//   3. names the missing effect: every effect of the vocabulary (effects.md:
+//      coulomb_motor, coulomb_load, restitution, saturation, compliance, delay,
+//      backlash_size, torque_offset) is added to the model in turn and fitted on the
+//      first part of the record — a bracketing scan over the parameter's range
+//      (event timing makes the cost non-smooth), then Ceres (Levenberg–Marquardt,
+//      central differences) from the best points — and scored by its BIC on that
+//      part and its RMS on the held-out rest.  An effect is named when it is
+//      decisive on both: ΔBIC < −decisive_bic against the current model and a
+//      held-out RMS below decisive_holdout × the current one.  The winner is refitted
+//      on the whole record (uncertainty from Ceres's covariance, scaled by the
+//      residual variance), added, and the search repeats for a second effect, until
+//      the residual is at the noise level or nothing is decisive;
+//   4. reports the named effects with their parameters and uncertainties, the RMS
+//      before and after (total and per region), the candidates' scores, and the
+//      corrected model.
+// Statuses: effect_found, no_discrepancy (the model already fits to the noise
+// level), unexplained (a gap no candidate closes decisively; the best is shown).
+#pragma once
+
+#include "backlash/measurements/measured_record.hpp"
+#include "backlash/model/case_spec.hpp"
+#include "backlash/numeric/effects.hpp"
+#include "backlash/numeric/hybrid_simulation.hpp"
+
+#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace backlash::discrepancy {
+
+enum class Status { EffectFound, NoDiscrepancy, Unexplained };
+const char* to_string(Status status);
+
+/// The effects the workflow can name (effects.md), in the order they are tried.
+const std::vector<std::string>& vocabulary();
+
+struct Parameter {
+  std::string name;  ///< "torque", "e", "limit", "stiffness", "damping", "tau", "backlash"
+  double value = 0;
+  double uncertainty = NAN;  ///< one standard deviation (from the fit's covariance)
+};
+
+/// One candidate effect fitted to the record.
+struct Candidate {
+  std::string effect;
+  std::vector<Parameter> parameters;
+  double rms = 0;          ///< on the whole record
+  double rms_fit = 0;      ///< on the fitted (first) part
+  double rms_holdout = 0;  ///< on the held-out (last) part
+  double bic = 0;          ///< on the fitted part: n·ln(SSE/n) + k·ln n
+  double delta_bic = 0;    ///< against the model it was added to
+  bool decisive = false;
+  int simulations = 0;     ///< simulations its fit used
+  double seconds = 0;      ///< time its fit took
+};
+
+/// A stretch of the record between events of the simulated model.
+struct Region {
+  double t_start = 0, t_end = 0;
+  std::string kind;  ///< "contact", "free", "mesh", "rest"
+  int samples = 0;
+  double rms_before = 0, rms_after = 0;
+};
+
+/// Features of one trace (measured or simulated).
+struct Features {
+  double overshoot = NAN;        ///< max (θo − θR)·sign(step) [rad]
+  double final_error = NAN;      ///< mean θo − θR over the last tenth of the record
+  double decay_rate = NAN;       ///< ln of successive |θo − θR| peak ratios per second (< 0: decaying)
+  double cycle_amplitude = NAN;  ///< half the peak-to-peak over the record's last third
+  double cycle_period = NAN;     ///< from the crossings of the last third's mean
+};
+
+struct DiscrepancyOptions {
+  double holdout_fraction = 0.3;  ///< the last part of the record held out of every fit
+  double decisive_bic = 10;       ///< a "very strong" BIC difference (Kass & Raftery)
+  double decisive_holdout = 0.8;  ///< the held-out RMS must shrink at least to this fraction
+  double noise_level = 1.15;      ///< "at the noise level": RMS ≤ this × σ
+  int max_effects = 3;
+  std::vector<std::string> candidates = vocabulary();  ///< which effects to try
+  int threads = 2;                ///< candidates fitted in parallel (numeric work: threads)
+};
+
+struct DiscrepancyResult {
+  Status status = Status::NoDiscrepancy;
+  double noise = 0;                  ///< σ of theta_out estimated from the record
+  double rms_before = 0, rms_after = 0;
+  double first_departure = NAN;      ///< first time the residual leaves the noise band (NaN: never)
+  std::vector<Candidate> effects;    ///< named, in the order found
+  std::vector<std::vector<Candidate>> rounds;  ///< every candidate of every round, best first
+  std::vector<Region> regions;
+  Features measured, nominal, corrected;
+  std::vector<numeric::SimulationEvent> nominal_events, corrected_events;
+  numeric::Parameters parameters;    ///< of the corrected model
+  numeric::Effects corrected_effects;
+  std::vector<double> t, theta_measured, theta_nominal, theta_corrected;
+  int simulations = 0;
+  double seconds = 0;
+};
+
+/// The whole workflow.  Throws std::invalid_argument for a record the model cannot be
+/// compared with (too few samples before t_end, a step of 0).
+DiscrepancyResult find_discrepancy(const model::CaseSpec& model, const measurements::MeasuredRecord& data, double step,
+                                   const DiscrepancyOptions& options = {});
+
+/// σ of a uniformly or irregularly sampled smooth signal plus noise, from the record alone.
+double estimate_noise(const std::vector<double>& y);
+
+/// The features of a trace.
+Features features_of(const std::vector<double>& t, const std::vector<double>& theta, double theta_R, double step);
+
+/// The files of `discrepancy --out DIR`, by name: discrepancy.md (the page), figures
+/// (measured_vs_models.svg, residual.svg, candidates.svg), discrepancy.json, corrected.toml.
+std::vector<std::pair<std::string, std::string>> report_files(const model::CaseSpec& model,
+                                                              const std::string& data_name,
+                                                              const DiscrepancyResult& result, double step);
+
+/// The JSON document of `discrepancy --json` (DESIGN.md §3's keys and more).
+std::string to_json(const model::CaseSpec& model, const DiscrepancyResult& result, double step);
+
+/// The corrected model as a case file: the nominal file's parameters, the backlash if it was
+/// refitted, and an [effects] table with the named effects (exact decimals of the fitted values).
+std::string corrected_case_file(const model::CaseSpec& model, const DiscrepancyResult& result, double step);
+
+}  // namespace backlash::discrepancy

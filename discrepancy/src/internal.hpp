@@ -1,0 +1,93 @@
+// discrepancy/src/internal.hpp (internal) — the pieces of the workflow.
+#pragma once
+
+#include "backlash/discrepancy/discrepancy.hpp"
+#include "backlash/numeric/effects_simulation.hpp"
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace backlash::discrepancy::detail {
+
+/// A model the workflow simulates: nominal parameters and effects.
+struct ModelPoint {
+  numeric::Parameters p;
+  numeric::Effects e;
+};
+
+/// One parameter of a candidate effect, searched over [low, high] (logarithmically when
+/// `logarithmic`): the fit works in u ∈ [0, 1].
+struct ParameterRange {
+  std::string name;
+  double low = 0, high = 1;
+  bool logarithmic = false;
+  double value(double u) const;
+  double derivative(double u) const;  ///< dvalue/du
+};
+
+/// An effect of the vocabulary as something the fit can vary.
+struct EffectCandidate {
+  std::string effect;
+  std::vector<ParameterRange> ranges;
+  std::function<ModelPoint(const ModelPoint& base, const std::vector<double>& values)> apply;
+  /// The grid of the bracketing scan (points in u).
+  std::vector<std::vector<double>> scan() const;
+};
+
+/// The candidate for `effect` around the model `base` (ranges scaled to the model and experiment).
+EffectCandidate candidate_for(const std::string& effect, const ModelPoint& base, double step);
+
+/// The measured columns stacked with their weights (1/σ per column).
+struct Observations {
+  std::vector<double> t;                          ///< the record's times
+  std::vector<std::vector<double>> columns;       ///< theta_out, then theta_motor / theta_load if present
+  std::vector<int> which;                         ///< 0 theta_out, 1 theta_motor, 2 theta_load
+  std::vector<double> sigma;                      ///< per column
+  std::size_t fit_samples = 0;                    ///< the first part, fitted; the rest is held out
+  std::size_t size() const { return t.size(); }
+};
+
+/// Simulations of model points on the record's grid, through a validated family.
+class Simulator {
+ public:
+  Simulator(const Observations& data, double step, double t_end);
+  /// θ at the record's times for each observed column; nothing if the model is outside the
+  /// validated family or the simulation did not end in a normal status.
+  std::optional<std::vector<std::vector<double>>> traces(const ModelPoint& m, std::size_t samples,
+                                                         std::vector<numeric::SimulationEvent>* events = nullptr);
+  /// Validates the family at these model points (a candidate's range corners).
+  void prepare(const std::vector<ModelPoint>& points);
+  int simulations() const { return simulations_.load(); }
+
+ private:
+  const Observations& data_;
+  double step_, t_end_;
+  numeric::ValidatedModelFamily family_;
+  std::atomic<int> simulations_{0};
+};
+
+/// Weighted residuals of a model against the observations over the first `samples` samples.
+std::vector<double> residuals(const Observations& data, const std::vector<std::vector<double>>& traces,
+                              std::size_t from, std::size_t to);
+double sum_of_squares(const std::vector<double>& r);
+
+/// A candidate fitted: its parameters, and its scores.
+struct Fit {
+  bool ok = false;
+  std::vector<double> u;       ///< in [0, 1]
+  std::vector<double> values;  ///< physical
+  std::vector<double> uncertainty;
+  double sse_fit = 0;          ///< weighted, on the fitted part
+  int simulations = 0;
+};
+
+/// Fits a candidate added to `base`: the scan, then Ceres from the best points.  With
+/// `whole_record` the fit uses every sample and the covariance is computed.
+Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoint& base, const EffectCandidate& c,
+                  bool whole_record, const std::vector<double>* start_u = nullptr);
+
+}  // namespace backlash::discrepancy::detail
