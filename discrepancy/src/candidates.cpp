@@ -21,7 +21,7 @@ double ParameterRange::derivative(double u) const {
 std::vector<std::vector<double>> EffectCandidate::scan() const {
   std::vector<std::vector<double>> points;
   if (ranges.size() == 1) {
-    constexpr int n = 14;
+    constexpr int n = 40;  // fine: with many bounces or events the cost has many shallow valleys
     for (int i = 0; i < n; ++i) points.push_back({i / double(n - 1)});
   } else {
     constexpr int n0 = 7, n1 = 5;

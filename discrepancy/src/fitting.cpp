@@ -4,10 +4,17 @@
 // with the covariance of the final fit.
 #include "internal.hpp"
 
+#include "backlash/numeric/effects.hpp"
+
+#include <boost/math/tools/minima.hpp>
 #include <ceres/ceres.h>
+#include <glog/logging.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <numeric>
 
 namespace backlash::discrepancy::detail {
@@ -35,9 +42,15 @@ std::optional<std::vector<std::vector<double>>> Simulator::traces(const ModelPoi
   o.sample_times.assign(data_.t.begin(), data_.t.begin() + static_cast<std::ptrdiff_t>(samples));
   o.t_end = std::min(t_end_, o.sample_times.back()) + 1e-9;
   o.general_engine = true;
-  o.max_events = 200000;
+  o.max_events = 20000;  // a fit's trial point that needs more (a stiff, barely damped mesh) is a failed point
   ++simulations_;
-  const numeric::SimulationResult r = numeric::simulate_effects_step(*model, step_, o);
+  numeric::SimulationResult r;
+  try {
+    r = numeric::simulate_effects_step(*model, step_, o);
+  } catch (const std::exception& error) {  // a point the simulation cannot resolve: no trace there
+    if (std::getenv("BACKLASH_DEBUG_FITS")) std::fprintf(stderr, "discrepancy: simulation failed (%s): %s\n", m.e.describe().c_str(), error.what());
+    return std::nullopt;
+  }
   if (r.status == numeric::SimulationStatus::NonFinite || r.status == numeric::SimulationStatus::EventLimit ||
       r.status == numeric::SimulationStatus::Chattering || r.samples.size() != samples)
     return std::nullopt;
@@ -51,12 +64,12 @@ std::optional<std::vector<std::vector<double>>> Simulator::traces(const ModelPoi
   return out;
 }
 
-std::vector<double> residuals(const Observations& data, const std::vector<std::vector<double>>& traces, std::size_t from,
-                              std::size_t to) {
+std::vector<double> residuals(const Observations& data, const std::vector<std::vector<double>>& traces,
+                              const std::vector<std::size_t>& indices) {
   std::vector<double> r;
-  r.reserve((to - from) * data.columns.size());
+  r.reserve(indices.size() * data.columns.size());
   for (std::size_t c = 0; c < data.columns.size(); ++c)
-    for (std::size_t i = from; i < to; ++i) r.push_back((data.columns[c][i] - traces[c][i]) / data.sigma[c]);
+    for (std::size_t i : indices) r.push_back((data.columns[c][i] - traces[c][i]) / data.sigma[c]);
   return r;
 }
 
@@ -73,8 +86,9 @@ struct Objective {
   const Observations& data;
   const ModelPoint& base;
   const EffectCandidate& candidate;
-  std::size_t samples;
+  const std::vector<std::size_t>& indices;  ///< the samples fitted
   std::atomic<int>& calls;  ///< simulations of this fit
+  std::chrono::steady_clock::time_point deadline;  ///< past it, no further simulation
 
   ModelPoint point(const double* u) const {
     std::vector<double> values;
@@ -82,10 +96,11 @@ struct Objective {
     return candidate.apply(base, values);
   }
   std::optional<std::vector<double>> residuals_at(const double* u) const {
+    if (std::chrono::steady_clock::now() > deadline) return std::nullopt;
     ++calls;
-    const auto traces = simulator.traces(point(u), samples);
+    const auto traces = simulator.traces(point(u), indices.back() + 1);
     if (!traces) return std::nullopt;
-    return residuals(data, *traces, 0, samples);
+    return residuals(data, *traces, indices);
   }
 };
 
@@ -106,9 +121,19 @@ struct Solved {
   std::vector<double> covariance;  ///< of u (k × k), scaled by the residual variance
 };
 
-Solved solve(const Objective& objective, std::vector<double> u, bool with_covariance) {
+// Ceres reports through glog: a failed evaluation is a status here, not a line on stderr.
+void quiet_ceres() {
+  static const bool once = [] {
+    FLAGS_minloglevel = google::GLOG_FATAL;
+    return true;
+  }();
+  (void)once;
+}
+
+Solved solve(const Objective& objective, std::vector<double> u, bool with_covariance, int iterations) {
+  quiet_ceres();
   const int k = static_cast<int>(u.size());
-  const int n = static_cast<int>(objective.samples * objective.data.columns.size());
+  const int n = static_cast<int>(objective.indices.size() * objective.data.columns.size());
   auto* cost = new ceres::DynamicNumericDiffCostFunction<CostFunctor, ceres::CENTRAL>(new CostFunctor{&objective});
   cost->AddParameterBlock(k);
   cost->SetNumResiduals(n);
@@ -120,7 +145,7 @@ Solved solve(const Objective& objective, std::vector<double> u, bool with_covari
   }
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_QR;
-  options.max_num_iterations = 25;
+  options.max_num_iterations = iterations;
   options.function_tolerance = 1e-10;
   options.parameter_tolerance = 1e-9;
   options.logging_type = ceres::SILENT;
@@ -130,7 +155,14 @@ Solved solve(const Objective& objective, std::vector<double> u, bool with_covari
   Solved out;
   out.u = u;
   out.sse = 2 * summary.final_cost;
-  if (with_covariance && n > k) {
+  // The covariance, from a Jacobian that every simulation around the optimum could deliver.
+  std::vector<double> jacobian_values;
+  ceres::CRSMatrix jacobian;
+  double cost_value = 0;
+  const bool evaluated = with_covariance && n > k &&
+                         problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost_value, nullptr, nullptr, &jacobian) &&
+                         std::all_of(jacobian.values.begin(), jacobian.values.end(), [](double v) { return std::isfinite(v); });
+  if (evaluated) {
     ceres::Covariance::Options covariance_options;
     covariance_options.algorithm_type = ceres::DENSE_SVD;
     covariance_options.null_space_rank = -1;
@@ -148,12 +180,76 @@ Solved solve(const Objective& objective, std::vector<double> u, bool with_covari
 
 }  // namespace
 
+namespace {
+
+// The samples up to time `until` (at least 8).
+std::vector<std::size_t> prefix(const Observations& data, const std::vector<std::size_t>& indices, double until) {
+  std::size_t n = 0;
+  while (n < indices.size() && data.t[indices[n]] <= until) ++n;
+  n = std::min(indices.size(), std::max<std::size_t>(8, n));
+  return std::vector<std::size_t>(indices.begin(), indices.begin() + static_cast<std::ptrdiff_t>(n));
+}
+
+// One parameter within ±cell of a start: a grid of 11 points first (the cost can have several
+// narrow valleys there: Brent alone, which assumes one, jumps over them), then Brent's
+// minimisation in the best grid cell — robust where event timing puts kinks in the cost.
+Solved brent(const Objective& objective, double start, double cell) {
+  auto sse = [&](double x) {
+    const double at[1] = {x};
+    const auto r = objective.residuals_at(at);
+    return r ? sum_of_squares(*r) : INFINITY;
+  };
+  const double lo = std::max(0.0, start - cell), hi = std::min(1.0, start + cell);
+  constexpr int points = 11;
+  double best_x = start, best_value = sse(start);
+  for (int i = 0; i < points; ++i) {
+    const double x = lo + (hi - lo) * i / (points - 1), value = sse(x);
+    if (value < best_value) best_x = x, best_value = value;
+  }
+  const double spacing = (hi - lo) / (points - 1);
+  std::uintmax_t iterations = 60;
+  const auto [x, value] = boost::math::tools::brent_find_minima(sse, std::max(0.0, best_x - spacing),
+                                                                std::min(1.0, best_x + spacing), 40, iterations);
+  return value < best_value ? Solved{{x}, value, {}} : Solved{{best_x}, best_value, {}};
+}
+
+// The best distinct points of the candidate's scan on these samples.
+std::vector<std::vector<double>> scan_starts(const Objective& objective, const EffectCandidate& c) {
+  const std::size_t k = c.ranges.size();
+  std::vector<std::pair<double, std::vector<double>>> scored;
+  for (const std::vector<double>& u : c.scan()) {
+    const auto r = objective.residuals_at(u.data());
+    if (r) scored.push_back({sum_of_squares(*r), u});
+  }
+  std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<std::vector<double>> starts;
+  const std::size_t wanted = k == 1 ? 3 : 2;
+  for (const auto& [sse, u] : scored) {
+    if (starts.size() >= wanted) break;
+    bool distinct = true;
+    for (const auto& s : starts)
+      for (std::size_t i = 0; i < k; ++i) distinct = distinct && std::fabs(s[i] - u[i]) > (k == 1 ? 0.05 : 0.1);
+    if (starts.empty() || distinct) starts.push_back(u);
+  }
+  return starts;
+}
+
+}  // namespace
+
+// The fit grows its horizon: scanned and refined up to a quarter servo period past the base
+// model's first departure from the record (where the response still depends smoothly on the
+// parameter — over a long record a lively gear's response, say with a high restitution, is
+// nearly chaotic in it), then refined from there on horizons growing by half, the bracket
+// narrowing as the valley of the cost does.  Given a start (a refit), only the last stage runs.
 Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoint& base, const EffectCandidate& c,
-                  bool whole_record, const std::vector<double>* start_u) {
+                  bool whole_record, const std::vector<double>* start_u, double seconds, double departure) {
   Fit fit;
   std::atomic<int> calls{0};
-  const std::size_t samples = whole_record ? data.size() : data.fit_samples;
-  const Objective objective{simulator, data, base, c, samples, calls};
+  const auto deadline = std::isfinite(seconds) ? std::chrono::steady_clock::now() +
+                                                    std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                        std::chrono::duration<double>(seconds))
+                                              : std::chrono::steady_clock::time_point::max();
+  const std::vector<std::size_t>& samples = whole_record ? data.all_indices : data.fit_indices;
   // The family validated over the candidate's whole range (its corners).
   std::vector<ModelPoint> corners;
   const std::size_t k = c.ranges.size();
@@ -163,32 +259,49 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
     corners.push_back(c.apply(base, values));
   }
   simulator.prepare(corners);
-  // Starting points: the given one, or the best two of the scan (distinct cells).
+  // The horizons: from a quarter servo period past where the base model first leaves the noise
+  // band (the first events that tell the parameter apart), growing by half each stage.
+  const double t0 = data.t.front(), t_end = data.t.back();
+  std::vector<double> horizons{t_end};
   std::vector<std::vector<double>> starts;
   if (start_u) {
     starts.push_back(*start_u);
   } else {
-    std::vector<std::pair<double, std::vector<double>>> scored;
-    for (const std::vector<double>& u : c.scan()) {
-      const auto r = objective.residuals_at(u.data());
-      if (r) scored.push_back({sum_of_squares(*r), u});
-    }
-    std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (const auto& [sse, u] : scored) {
-      if (starts.size() >= 2) break;
-      bool distinct = true;
-      for (const auto& s : starts)
-        for (std::size_t i = 0; i < k; ++i) distinct = distinct && std::fabs(s[i] - u[i]) > 0.1;
-      if (starts.empty() || distinct) starts.push_back(u);
-    }
+    const double first = std::isfinite(departure) ? departure : t0;
+    double h = std::min(t_end, std::max(first + 0.25 * numeric::servo_period(base.p), t0 + 0.05 * (t_end - t0)));
+    horizons.clear();
+    for (; h < t_end; h = t0 + 1.5 * (h - t0)) horizons.push_back(h);
+    horizons.push_back(t_end);
+    const std::vector<std::size_t> first_samples = prefix(data, samples, horizons.front());
+    starts = scan_starts(Objective{simulator, data, base, c, first_samples, calls, deadline}, c);
   }
+  // One parameter: the best two distinct valleys are followed from stage to stage (a valley
+  // that looks best on a short horizon can lose on a longer one).
   Solved best;
-  for (const std::vector<double>& u : starts) {
-    Solved s = solve(objective, u, whole_record);
-    if (s.sse < best.sse) best = std::move(s);
+  double cell = start_u ? 0.02 : 1.0 / 39;  // one parameter: Brent's bracket, narrowing as the horizon grows
+  for (std::size_t stage = 0; stage < horizons.size(); ++stage, cell = std::max(0.004, 0.6 * cell)) {
+    const std::vector<std::size_t> stage_samples = prefix(data, samples, horizons[stage]);
+    const Objective objective{simulator, data, base, c, stage_samples, calls, deadline};
+    std::vector<Solved> found;
+    for (const std::vector<double>& u : starts) {
+      Solved s = k == 1 ? brent(objective, u[0], cell) : solve(objective, u, false, 25);
+      if (std::isfinite(s.sse)) found.push_back(std::move(s));
+    }
+    if (found.empty()) return fit;
+    std::sort(found.begin(), found.end(), [](const Solved& a, const Solved& b) { return a.sse < b.sse; });
+    best = found.front();
+    if (std::getenv("BACKLASH_DEBUG_FITS") && k == 1) {
+      std::fprintf(stderr, "%s stage %zu horizon %.3f cell %.4f:", c.effect.c_str(), stage, horizons[stage], cell);
+      for (const Solved& f : found) std::fprintf(stderr, " u=%.5f (%.5g) sse %.4g", f.u[0], c.ranges[0].value(f.u[0]), f.sse);
+      std::fprintf(stderr, "\n");
+    }
+    starts = {best.u};
+    for (const Solved& s : found)
+      if (k == 1 && starts.size() < 2 && std::fabs(s.u[0] - best.u[0]) > cell) starts.push_back(s.u);
+    if (stage + 1 == horizons.size() && whole_record) best.covariance = solve(objective, best.u, true, 0).covariance;
   }
   fit.simulations = calls.load();
-  if (!std::isfinite(best.sse)) return fit;
+  fit.budget_exhausted = std::chrono::steady_clock::now() > deadline;
   fit.ok = true;
   fit.u = best.u;
   fit.sse_fit = best.sse;

@@ -5,6 +5,7 @@
 #include "backlash/numeric/effects_simulation.hpp"
 
 #include <atomic>
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -47,7 +48,9 @@ struct Observations {
   std::vector<std::vector<double>> columns;       ///< theta_out, then theta_motor / theta_load if present
   std::vector<int> which;                         ///< 0 theta_out, 1 theta_motor, 2 theta_load
   std::vector<double> sigma;                      ///< per column
-  std::size_t fit_samples = 0;                    ///< the first part, fitted; the rest is held out
+  /// The samples fitted, and those held out of every fit: the record cut in ten blocks, the
+  /// third, sixth and ninth held out — they cover the transient and the end alike.
+  std::vector<std::size_t> fit_indices, holdout_indices, all_indices;
   std::size_t size() const { return t.size(); }
 };
 
@@ -70,9 +73,9 @@ class Simulator {
   std::atomic<int> simulations_{0};
 };
 
-/// Weighted residuals of a model against the observations over the first `samples` samples.
+/// Weighted residuals of a model against the observations at these samples.
 std::vector<double> residuals(const Observations& data, const std::vector<std::vector<double>>& traces,
-                              std::size_t from, std::size_t to);
+                              const std::vector<std::size_t>& indices);
 double sum_of_squares(const std::vector<double>& r);
 
 /// A candidate fitted: its parameters, and its scores.
@@ -81,13 +84,18 @@ struct Fit {
   std::vector<double> u;       ///< in [0, 1]
   std::vector<double> values;  ///< physical
   std::vector<double> uncertainty;
-  double sse_fit = 0;          ///< weighted, on the fitted part
+  double sse_fit = 0;          ///< weighted, on the fitted samples
   int simulations = 0;
+  bool budget_exhausted = false;  ///< the fit stopped at its time budget (its best point is kept)
 };
 
 /// Fits a candidate added to `base`: the scan, then Ceres from the best points.  With
 /// `whole_record` the fit uses every sample and the covariance is computed.
+/// The fit stops at `seconds` (its best point kept; Fit::budget_exhausted says so).
+/// `departure`: where the base model first leaves the record's noise band — the first stage of
+/// the growing horizon ends a quarter servo period after it.
 Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoint& base, const EffectCandidate& c,
-                  bool whole_record, const std::vector<double>* start_u = nullptr);
+                  bool whole_record, const std::vector<double>* start_u = nullptr, double seconds = INFINITY,
+                  double departure = NAN);
 
 }  // namespace backlash::discrepancy::detail

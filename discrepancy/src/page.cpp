@@ -194,6 +194,7 @@ std::string to_json(const model::CaseSpec& model, const DiscrepancyResult& r, do
                           {"delta_bic", json_number(c.delta_bic)},
                           {"score", json_number(c.delta_bic)},
                           {"decisive", c.decisive},
+                          {"at_range_edge", c.at_range_edge},
                           {"simulations", c.simulations},
                           {"seconds", c.seconds}};
       round.push_back(item);
@@ -225,6 +226,8 @@ std::string to_json(const model::CaseSpec& model, const DiscrepancyResult& r, do
                      {"rms_before", r.rms_before},
                      {"rms_after", r.rms_after},
                      {"noise", r.noise},
+                     {"gap_before", r.gap_before},
+                     {"gap_after", r.gap_after},
                      {"first_departure", json_number(r.first_departure)},
                      {"candidates", candidates},
                      {"rounds", rounds},

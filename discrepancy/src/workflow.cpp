@@ -91,8 +91,16 @@ Observations observations_of(const measurements::MeasuredRecord& data, double ho
   add(data.theta_out, 0);
   if (data.theta_motor) add(*data.theta_motor, 1);
   if (data.theta_load) add(*data.theta_load, 2);
-  o.fit_samples = std::max<std::size_t>(8, static_cast<std::size_t>(std::floor((1 - holdout_fraction) * data.size())));
-  o.fit_samples = std::min(o.fit_samples, data.size());
+  // Ten blocks; with the default 0.3 held out, the third, sixth and ninth (every k-th block,
+  // k = round(1/fraction)), so the held-out samples see the transient and the end alike.
+  const std::size_t n = data.size();
+  const int every = holdout_fraction > 0 ? std::max(2, static_cast<int>(std::lround(1 / holdout_fraction))) : 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const int block = static_cast<int>(10 * i / n);
+    (every > 0 && block % every == every - 1 ? o.holdout_indices : o.fit_indices).push_back(i);
+    o.all_indices.push_back(i);
+  }
+  if (o.holdout_indices.empty()) o.holdout_indices = o.fit_indices;
   return o;
 }
 
@@ -111,8 +119,8 @@ struct Scores {
 
 Scores score(const Observations& o, const std::vector<std::vector<double>>& traces) {
   Scores s;
-  const std::vector<double> fit = detail::residuals(o, traces, 0, o.fit_samples);
-  const std::vector<double> held = detail::residuals(o, traces, o.fit_samples, o.size());
+  const std::vector<double> fit = detail::residuals(o, traces, o.fit_indices);
+  const std::vector<double> held = detail::residuals(o, traces, o.holdout_indices);
   s.sse_fit = detail::sum_of_squares(fit);
   s.sse_holdout = detail::sum_of_squares(held);
   s.sse = s.sse_fit + s.sse_holdout;
@@ -138,6 +146,8 @@ std::vector<Parameter> reported(const EffectCandidate& c, const detail::Fit& fit
   return out;
 }
 
+double first_departure(const Observations& o, const std::vector<double>& model);
+
 struct Trial {
   EffectCandidate candidate;
   detail::Fit fit;
@@ -147,8 +157,8 @@ struct Trial {
 
 // Every candidate of a round, fitted on the first part and scored (threads over candidates).
 std::vector<Trial> round_of(Simulator& simulator, const Observations& o, const ModelPoint& current, int current_k,
-                            const Scores& current_scores, const std::vector<std::string>& effects, double step,
-                            const DiscrepancyOptions& options) {
+                            const Scores& current_scores, double departure, const std::vector<std::string>& effects,
+                            double step, const DiscrepancyOptions& options) {
   std::vector<Trial> trials(effects.size());
   std::atomic<std::size_t> next{0};
   auto work = [&] {
@@ -156,8 +166,15 @@ std::vector<Trial> round_of(Simulator& simulator, const Observations& o, const M
       const auto started = std::chrono::steady_clock::now();
       Trial& t = trials[i];
       t.candidate = detail::candidate_for(effects[i], current, step);
-      t.fit = detail::fit_candidate(simulator, o, current, t.candidate, false);
       t.result.effect = effects[i];
+      try {
+        t.fit = detail::fit_candidate(simulator, o, current, t.candidate, false, nullptr, options.candidate_seconds, departure);
+        if (t.fit.budget_exhausted)
+          t.result.failure = "its fit reached the time budget of " + std::to_string(options.candidate_seconds) + " s";
+      } catch (const std::exception& error) {  // a candidate that cannot be simulated is a failed candidate
+        t.fit = detail::Fit{};
+        t.result.failure = error.what();
+      }
       t.result.simulations = t.fit.simulations;
       if (t.fit.ok) {
         t.point = t.candidate.apply(current, t.fit.values);
@@ -172,8 +189,16 @@ std::vector<Trial> round_of(Simulator& simulator, const Observations& o, const M
           const int k = current_k + static_cast<int>(t.candidate.ranges.size());
           t.result.bic = s.bic(k);
           t.result.delta_bic = t.result.bic - current_scores.bic(current_k);
-          t.result.decisive = t.result.delta_bic < -options.decisive_bic &&
-                              t.result.rms_holdout < options.decisive_holdout * current_scores.rms_holdout();
+          // Decisive on both: the BIC, and the held-out samples — they must shrink, or, when the
+          // model already meets them at the noise level, at least not get worse.
+          const double held = current_scores.rms_holdout();
+          const bool confirmed = t.result.rms_holdout < options.decisive_holdout * held ||
+                                 (held <= options.noise_level && t.result.rms_holdout <= 1.02 * held);
+          // A parameter pinned at the edge of its range says the effect, as parameterised, cannot be
+          // told from its limit (a mesh at the stiffest end is a rigid gear): not decisive.
+          const bool at_edge = std::any_of(t.fit.u.begin(), t.fit.u.end(), [](double u) { return u < 1e-3 || u > 1 - 1e-3; });
+          t.result.at_range_edge = at_edge;
+          t.result.decisive = t.result.delta_bic < -options.decisive_bic && confirmed && !at_edge;
         } else {
           t.fit.ok = false;
         }
@@ -303,6 +328,7 @@ DiscrepancyResult find_discrepancy(const model::CaseSpec& spec, const measuremen
   result.nominal_events = nominal_events;
   Scores current_scores = score(o, *nominal_traces);
   result.rms_before = current_scores.rms_theta_out;
+  result.gap_before = current_scores.rms();
   result.first_departure = first_departure(o, result.theta_nominal);
 
   ModelPoint current = nominal;
@@ -311,7 +337,10 @@ DiscrepancyResult find_discrepancy(const model::CaseSpec& spec, const measuremen
   std::vector<std::string> remaining = options.candidates;
   while (current_scores.rms() > options.noise_level && static_cast<int>(result.effects.size()) < options.max_effects &&
          !remaining.empty()) {
-    std::vector<Trial> trials = round_of(simulator, o, current, current_k, current_scores, remaining, step, options);
+    const auto current_traces = simulator.traces(current, o.size());
+    const double departure = current_traces ? first_departure(o, (*current_traces)[0]) : NAN;
+    std::vector<Trial> trials =
+        round_of(simulator, o, current, current_k, current_scores, departure, remaining, step, options);
     std::vector<Candidate> round;
     for (const Trial& t : trials) round.push_back(t.result);
     result.rounds.push_back(round);
@@ -342,6 +371,7 @@ DiscrepancyResult find_discrepancy(const model::CaseSpec& spec, const measuremen
   result.theta_corrected = corrected ? (*corrected)[0] : result.theta_nominal;
   result.corrected_events = corrected_events;
   result.rms_after = corrected ? score(o, *corrected).rms_theta_out : result.rms_before;
+  result.gap_after = corrected ? score(o, *corrected).rms() : result.gap_before;
   result.parameters = current.p;
   result.corrected_effects = current.e;
   const double theta_R = nominal.p.theta_R;

@@ -16,13 +16,18 @@
 //      amplitude and period);
 //   3. names the missing effect: every effect of the vocabulary (effects.md:
 //      coulomb_motor, coulomb_load, restitution, saturation, compliance, delay,
-//      backlash_size, torque_offset) is added to the model in turn and fitted on the
-//      first part of the record — a bracketing scan over the parameter's range
-//      (event timing makes the cost non-smooth), then Ceres (Levenberg–Marquardt,
-//      central differences) from the best points — and scored by its BIC on that
-//      part and its RMS on the held-out rest.  An effect is named when it is
-//      decisive on both: ΔBIC < −decisive_bic against the current model and a
-//      held-out RMS below decisive_holdout × the current one.  The winner is refitted
+//      backlash_size, torque_offset) is added to the model in turn and fitted on
+//      seven of ten blocks of the record (the third, sixth and ninth are held out,
+//      so that they see the transient and the end alike) — a bracketing scan over
+//      the parameter's range, then, event timing making the cost non-smooth,
+//      Brent's minimisation in the best bracket for one parameter or Ceres
+//      (Levenberg–Marquardt, central differences) from the best points for two —
+//      and scored by its BIC on the fitted samples and its RMS on the held-out ones.
+//      An effect is named when it is decisive on both: ΔBIC < −decisive_bic against
+//      the current model, and a held-out RMS below decisive_holdout × the current
+//      one (or, where the model already meets the held-out samples at the noise
+//      level, not above them) — and none of its parameters pinned at an end of its range
+//      (a mesh at the stiffest end is a rigid gear, not a compliance).  The winner is refitted
 //      on the whole record (uncertainty from Ceres's covariance, scaled by the
 //      residual variance), added, and the search repeats for a second effect, until
 //      the residual is at the noise level or nothing is decisive;
@@ -62,13 +67,15 @@ struct Candidate {
   std::string effect;
   std::vector<Parameter> parameters;
   double rms = 0;          ///< on the whole record
-  double rms_fit = 0;      ///< on the fitted (first) part
-  double rms_holdout = 0;  ///< on the held-out (last) part
-  double bic = 0;          ///< on the fitted part: n·ln(SSE/n) + k·ln n
+  double rms_fit = 0;      ///< weighted (σ = 1), on the fitted samples
+  double rms_holdout = 0;  ///< weighted (σ = 1), on the held-out samples
+  double bic = 0;          ///< on the fitted samples: n·ln(SSE/n) + k·ln n
   double delta_bic = 0;    ///< against the model it was added to
   bool decisive = false;
+  bool at_range_edge = false;  ///< a parameter pinned at an end of its range (then never decisive)
   int simulations = 0;     ///< simulations its fit used
   double seconds = 0;      ///< time its fit took
+  std::string failure;     ///< why its fit failed or stopped early, if it did
 };
 
 /// A stretch of the record between events of the simulated model.
@@ -89,19 +96,21 @@ struct Features {
 };
 
 struct DiscrepancyOptions {
-  double holdout_fraction = 0.3;  ///< the last part of the record held out of every fit
+  double holdout_fraction = 0.3;  ///< the blocks held out of every fit (every third of ten)
   double decisive_bic = 10;       ///< a "very strong" BIC difference (Kass & Raftery)
   double decisive_holdout = 0.8;  ///< the held-out RMS must shrink at least to this fraction
   double noise_level = 1.15;      ///< "at the noise level": RMS ≤ this × σ
   int max_effects = 3;
   std::vector<std::string> candidates = vocabulary();  ///< which effects to try
   int threads = 2;                ///< candidates fitted in parallel (numeric work: threads)
+  double candidate_seconds = 3;   ///< a candidate's fit stops here with its best point (a stiff mesh can be slow)
 };
 
 struct DiscrepancyResult {
   Status status = Status::NoDiscrepancy;
   double noise = 0;                  ///< σ of theta_out estimated from the record
-  double rms_before = 0, rms_after = 0;
+  double rms_before = 0, rms_after = 0;  ///< of theta_out [rad]
+  double gap_before = 0, gap_after = 0;  ///< RMS over every measured column, in units of each column's σ
   double first_departure = NAN;      ///< first time the residual leaves the noise band (NaN: never)
   std::vector<Candidate> effects;    ///< named, in the order found
   std::vector<std::vector<Candidate>> rounds;  ///< every candidate of every round, best first
