@@ -9,7 +9,9 @@
 // errors are reported here in the one-line form with exit code 2 instead.
 #include "commands.hpp"
 
+#include "backlash/measurements/measured_record.hpp"
 #include "backlash/model/case_spec.hpp"
+#include "backlash/reports/output_directory.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -48,6 +50,7 @@ int main(int argument_count, char** arguments) {
   backlash::cli::register_limit_cycle_command(app);
   backlash::cli::register_sweep_command(app);
   backlash::cli::register_import_command(app);
+  backlash::cli::register_discrepancy_command(app);
 
   try {
     app.parse(argument_count, arguments);
@@ -58,6 +61,10 @@ int main(int argument_count, char** arguments) {
     return report_error(usage_error.what(), exit_code_for_bad_input);
   } catch (const backlash::model::CaseFileError& case_file_error) {
     return report_error(case_file_error.what(), exit_code_for_bad_input);
+  } catch (const backlash::measurements::MeasuredDataError& data_error) {
+    return report_error(data_error.what(), exit_code_for_bad_input);
+  } catch (const backlash::reports::BadInput& bad_output) {
+    return report_error(bad_output.what(), exit_code_for_bad_input);
   } catch (const std::exception& other_error) {
     return report_error(other_error.what(), exit_code_for_failure);
   }

@@ -1,101 +1,155 @@
 #include "backlash/reports/plot.hpp"
 
-#include <toml++/toml.h>
+#include "backlash/symbolic/escape.hpp"
 
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <fstream>
-#include <map>
+#include <iterator>
 #include <sstream>
-#include <unistd.h>
-#include <algorithm>
-#include <cstdint>
 
 namespace backlash::reports {
 
 namespace {
 
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) out += (c == '"' ? std::string("\\\"") : std::string(1, c));
-  return out + "\"";
+// A gnuplot single-quoted string ('' for a quote; no other escapes exist there).  Spaces
+// become no-break spaces: gnuplot's SVG splits enhanced text into <tspan>s and some
+// renderers drop a tspan's leading space ("θ_{o} vs" would read "θovs").
+std::string quoted(const std::string& text, bool keep_spaces = false) {
+  std::string out = "'";
+  for (char c : symbolic::escape::valid_utf8(text)) {
+    if (c == '\'') out += "''";
+    else if (c == ' ' && !keep_spaces) out += "\xC2\xA0";
+    else if (static_cast<unsigned char>(c) < 0x20) out += ' ';
+    else out += c;
+  }
+  return out + "'";
+}
+
+std::string number(double v) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof buffer, "%.10g", v);
+  return buffer;
+}
+
+std::string shell_quoted(const std::string& text) {
+  std::string out = "'";
+  for (char c : text) out += (c == '\'' ? std::string("'\\''") : std::string(1, c));
+  return out + "'";
+}
+
+// cairo stamps its PDFs with the time of day: overwrite the digits in place (same length,
+// so the cross-reference offsets stay valid) with the epoch, for byte-reproducible files.
+void fix_pdf_dates(const std::filesystem::path& file) {
+  std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
+  if (!io) return;
+  std::string bytes((std::istreambuf_iterator<char>(io)), std::istreambuf_iterator<char>());
+  bool changed = false;
+  for (const std::string key : {"/CreationDate (D:", "/ModDate (D:"}) {
+    for (std::size_t at = bytes.find(key); at != std::string::npos; at = bytes.find(key, at + 1)) {
+      const std::size_t digits = at + key.size();
+      std::size_t n = 0;
+      while (digits + n < bytes.size() && std::isdigit(static_cast<unsigned char>(bytes[digits + n])) && n < 14) ++n;
+      const std::string epoch = std::string("19700101000000").substr(0, n);
+      bytes.replace(digits, n, epoch);
+      changed = true;
+    }
+  }
+  if (!changed) return;
+  io.seekp(0);
+  io.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
 }  // namespace
 
-std::optional<std::string> render_svg(const Plot& plot, std::string* why) {
-  namespace fs = std::filesystem;
-  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) {
-    if (why) *why = "gnuplot is not installed";
-    return std::nullopt;
+bool has_data(const Plot& plot) {
+  if (plot.series.empty()) return false;
+  for (const Series& s : plot.series) {
+    bool finite = false;
+    for (std::size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) finite = finite || (std::isfinite(s.x[k]) && std::isfinite(s.y[k]));
+    if (!finite) return false;
   }
-  const fs::path dir = fs::temp_directory_path() / ("backlash-plot-" + std::to_string(::getpid()) + "-" +
-                                                      std::to_string(reinterpret_cast<std::uintptr_t>(&plot)));
-  fs::create_directories(dir);
-  std::ostringstream script;
-  script << "set terminal svg size " << plot.width << "," << plot.height << " dynamic enhanced font 'sans,12'\n"
-         << "set output " << quoted((dir / "plot.svg").string()) << "\n"
-         << "set title " << quoted(plot.title) << " noenhanced\n"
-         << "set xlabel " << quoted(plot.x_label) << "\nset ylabel " << quoted(plot.y_label) << "\n"
-         << "set grid\nset key outside right top noenhanced\n";
-  script << "plot ";
-  for (size_t i = 0; i < plot.series.size(); ++i) {
-    const Series& s = plot.series[i];
-    const fs::path data = dir / ("series" + std::to_string(i) + ".dat");
-    std::ofstream out(data);
-    out.precision(12);
-    for (size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) out << s.x[k] << " " << s.y[k] << "\n";
-    script << (i ? ", " : "") << quoted(data.string()) << " using 1:2 with " << s.style << " title " << quoted(s.label);
-  }
-  script << "\n";
-  {
-    std::ofstream out(dir / "plot.gp");
-    out << script.str();
-  }
-  const int status = std::system(("gnuplot " + quoted((dir / "plot.gp").string()) + " 2> " + quoted((dir / "err.txt").string())).c_str());
-  std::optional<std::string> svg;
-  if (status == 0) {
-    std::ifstream in(dir / "plot.svg");
-    std::stringstream buffer;
-    buffer << in.rdbuf();
-    svg = buffer.str();
-  } else if (why) {
-    std::ifstream in(dir / "err.txt");
-    std::getline(in, *why);
-  }
-  fs::remove_all(dir);
-  return svg;
+  return true;
 }
 
-std::string errata_markdown(const std::string& errata_directory) {
+std::string figure_csv(const Plot& plot) {
+  std::ostringstream out;
+  out << "series,x,y\n";
+  for (const Series& s : plot.series)
+    for (std::size_t k = 0; k < s.x.size() && k < s.y.size(); ++k)
+      if (std::isfinite(s.x[k]) && std::isfinite(s.y[k]))
+        out << symbolic::escape::csv_field(s.label) << "," << number(s.x[k]) << "," << number(s.y[k]) << "\n";
+  return out.str();
+}
+
+std::optional<std::string> render_figures(const std::vector<Plot>& plots, const std::filesystem::path& directory) {
   namespace fs = std::filesystem;
-  std::ostringstream md;
-  md << "# Errata ledger\n\nEvery number printed in the thesis that differs from the exact value beyond its printed "
-        "precision, with the exact value and a likely cause.  Source: `reports/errata/*.toml`; each entry is checked "
-        "by the test named after its place (tests/symbolic, tests/numeric).\n";
-  std::vector<fs::path> files;
-  for (const auto& entry : fs::directory_iterator(errata_directory))
-    if (entry.path().extension() == ".toml") files.push_back(entry.path());
-  std::sort(files.begin(), files.end());
-  for (const fs::path& file : files) {
-    const toml::table t = toml::parse_file(file.string());
-    const toml::array* list = t["erratum"].as_array();
-    md << "\n## " << file.filename().string() << " (" << (list ? list->size() : 0) << " entries)\n\n"
-       << "| where | case | quantity | printed | exact | likely cause |\n|---|---|---|---|---|---|\n";
-    if (!list) continue;
-    for (const toml::node& node : *list) {
-      const toml::table& e = *node.as_table();
-      std::string exact = e["exact"].value_or(std::string());
-      const std::string decimal = e["exact_decimal"].value_or(std::string());
-      if (exact.empty()) exact = decimal; else if (!decimal.empty()) exact += " = " + decimal;
-      std::string cause = e["cause"].value_or(std::string());
-      for (char& c : cause) if (c == '|') c = '/';
-      md << "| " << e["where"].value_or(std::string()) << " | " << e["case"].value_or(std::string()) << " | "
-         << e["quantity"].value_or(std::string()) << " | " << e["printed"].value_or(std::string()) << " | `" << exact << "` | "
-         << cause << " |\n";
+  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) return std::string("gnuplot is not installed");
+  std::ostringstream script;
+  script << "set encoding utf8\n";
+  for (std::size_t f = 0; f < plots.size(); ++f) {
+    const Plot& plot = plots[f];
+    for (std::size_t i = 0; i < plot.series.size(); ++i) {
+      const Series& s = plot.series[i];
+      script << "$d" << f << "_" << i << " << EOD\n";
+      for (std::size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
+        if (!std::isfinite(s.x[k]) || !std::isfinite(s.y[k])) script << "\n";
+        else script << number(s.x[k]) << " " << number(s.y[k]) << "\n";
+      }
+      script << "EOD\n";
     }
+    std::ostringstream body;
+    body << "reset\nset encoding utf8\n"
+         << "set title " << quoted(plot.title) << "\n"
+         << "set xlabel " << quoted(plot.x_label) << "\nset ylabel " << quoted(plot.y_label) << "\n"
+         << "set grid lc rgb '#dddddd'\nset key " << plot.key << " spacing 1.1\n"
+         << "set border lw 1\nset tics nomirror\nset xtics mirror\nset ytics mirror\n";
+    if (plot.x_range) body << "set xrange [" << number(plot.x_range->first) << ":" << number(plot.x_range->second) << "]\n";
+    if (plot.y_range) body << "set yrange [" << number(plot.y_range->first) << ":" << number(plot.y_range->second) << "]\n";
+    for (std::size_t l = 0; l < plot.labels.size(); ++l)
+      body << "set label " << (l + 1) << " " << quoted(plot.labels[l].text) << " at " << number(plot.labels[l].x) << ","
+           << number(plot.labels[l].y) << " font ',9' tc rgb '#555555'\n";
+    body << "plot ";
+    for (std::size_t i = 0; i < plot.series.size(); ++i) {
+      const Series& s = plot.series[i];
+      body << (i ? ", \\\n     " : "") << "$d" << f << "_" << i << " using 1:2 with " << s.style
+           << (s.in_key ? " title " + quoted(s.label) : std::string(" notitle"));
+    }
+    body << "\n";
+    const fs::path stem = fs::path("figures") / plot.name;
+    script << "set terminal svg size " << plot.width << "," << plot.height << " enhanced font 'DejaVu Sans,12' background '#ffffff'\n"
+           << "set output " << quoted(stem.string() + ".svg", true) << "\n"
+           << body.str() << "set output\n";
+    script << "set terminal pdfcairo size " << number(plot.width / 130.0) << "in," << number(plot.height / 130.0)
+           << "in enhanced font 'DejaVu Sans,8.5' background '#ffffff'\n"
+           << "set output " << quoted(stem.string() + ".pdf", true) << "\n"
+           << body.str() << "set output\n";
   }
-  return md.str();
+  const fs::path script_file = directory / "figures.gp";
+  {
+    std::ofstream out(script_file, std::ios::binary);
+    out << script.str();
+    if (!out) return std::string("cannot write the gnuplot script");
+  }
+  fs::create_directories(directory / "figures");
+  const fs::path log = directory / "figures.log";
+  const std::string command = "cd " + shell_quoted(directory.string()) + " && gnuplot figures.gp > figures.log 2>&1";
+  const int status = std::system(command.c_str());
+  std::optional<std::string> failure;
+  if (status != 0) {
+    std::ifstream in(log);
+    std::string line, last;
+    while (std::getline(in, line))
+      if (!line.empty()) last = line;
+    failure = "gnuplot failed: " + last;
+  }
+  std::error_code ignored;
+  fs::remove(script_file, ignored);
+  fs::remove(log, ignored);
+  if (!failure)
+    for (const Plot& plot : plots) fix_pdf_dates(directory / "figures" / (plot.name + ".pdf"));
+  return failure;
 }
 
 }  // namespace backlash::reports

@@ -65,6 +65,35 @@ TEST(Eq18_Eq20_General_MotorAloneLaplace, ClosedLoopMotorTransformIsTheThesisFor
   }
 }
 
+TEST(Eq21_General_MotorAloneVelocityLaplace, VelocityTransformIsSTimesThetaMMinusItsInitialValue) {
+  // Eq. 21: the motor's velocity transform when the output is measured at the motor (the
+  // closed-loop motor of eq. 16).  The transform of a derivative is s·Θm(s) − θm(0): with eq. 20
+  // for Θm and θm0 = θR + cot φ·θ̇m0 (eq. 19).  The printed eq. 21 is s times all of eq. 20 (and
+  // K·θ̇R for K·θR): it lacks −θm0, so it is improper and would put an impulse θm0·δ(t) into θ̇m.
+  int checked = 0;
+  for (const auto& branch : derive_general_branches()) {
+    if (branch.name.rfind("motor_", 0) != 0) continue;
+    const CaseParameters& p = branch.parameters;
+    const ex q = s() * s() + p.Fm / p.Jm * s() + p.K / p.Jm;
+    const ex theta0 = branch.free.separation_theta;
+    const ex eq20 = p.K * p.theta_R / (p.Jm * s() * q) + (theta0 * (s() + p.Fm / p.Jm) + v0()) / q;
+    const ex eq21 = s() * eq20 - theta0;
+    EXPECT_TRUE(same(branch.free.motor_velocity.laplace, eq21))
+        << branch.name << ": returned " << branch.free.motor_velocity.laplace << " instead of " << eq21;
+    // proper: numerator of lower degree in s than the denominator (no impulse)
+    const ex fraction = numer_denom(normal(eq21));
+    EXPECT_LT(fraction.op(0).degree(s()), fraction.op(1).degree(s())) << branch.name << ": eq. 21 is not proper";
+    // the printed form differs from it by exactly θm0
+    EXPECT_TRUE(same(s() * eq20 - eq21, theta0)) << branch.name;
+    // its inverse is the derivative of θm(t), term by term, and starts at θ̇m0
+    EXPECT_TRUE((branch.free.motor_velocity.solution - branch.free.motor_position.solution.derivative()).is_zero({}))
+        << branch.name << ": L^-1[eq. 21] is not d/dt of L^-1[eq. 20]";
+    EXPECT_TRUE(same(branch.free.motor_velocity.solution.at_zero(), v0())) << branch.name;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 6) << "returned " << checked << " motor-measured branches instead of 6";
+}
+
 TEST(Eq19_General_SeparationLine, CotPhiIsTheMotorAloneIsoclineOfSlopeEta3) {
   const GeneralSymbols& g = general_symbols();
   for (const auto& branch : derive_general_branches()) {

@@ -1,11 +1,17 @@
 // backlash/reports/plot.hpp — figures for the reports, drawn by gnuplot.
 //
-// A Plot is a list of series (x, y columns) with labels; `render_svg` writes
-// the data and a gnuplot script to a scratch folder, runs gnuplot, and returns
-// the SVG text (or nothing, with the reason, when gnuplot is missing or fails:
-// the report then says so instead of failing).
+// A Plot is a list of series (x, y columns; a NaN breaks a line) with labels,
+// axis titles (with units) and a legend.  render_figures() writes one gnuplot
+// script with every figure as inline data blocks and runs gnuplot once in the
+// output folder: figures/NAME.svg (for the web pages) and figures/NAME.pdf (vector,
+// for report.pdf; cairo's time stamp is replaced by the epoch, so the bytes are
+// the same from run to run).
+// figure_csv() gives each figure's data (series,x,y) so a reader, and the tests,
+// can check what was drawn.  Without gnuplot nothing is drawn and the reason
+// is returned (the report says so instead of failing).
 #pragma once
 
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,19 +21,35 @@ namespace backlash::reports {
 struct Series {
   std::string label;
   std::vector<double> x, y;
-  std::string style = "lines";  ///< gnuplot style: "lines", "points pt 7 ps 0.5", "linespoints"
+  /// gnuplot "with" clause: "lines lw 2", "points pt 7 ps 0.6", "lines dt 2" …
+  std::string style = "lines lw 2";
+  bool in_key = true;  ///< shown in the legend
+};
+
+struct Label {
+  std::string text;
+  double x = 0, y = 0;
 };
 
 struct Plot {
-  std::string title, x_label, y_label;
+  std::string name;                ///< file stem under figures/, e.g. "fig21_case_V_phase_plane"
+  std::string title;               ///< names the thesis figure
+  std::string x_label, y_label;    ///< with units
   std::vector<Series> series;
-  int width = 900, height = 600;
+  std::vector<Label> labels;
+  std::optional<std::pair<double, double>> x_range, y_range;
+  std::string key = "outside right top";
+  int width = 1000, height = 650;  ///< SVG size in pixels; the PDF is drawn at 130 px per inch
 };
 
-/// SVG text, or nothing (and `why`) when gnuplot is unavailable or fails.
-std::optional<std::string> render_svg(const Plot& plot, std::string* why = nullptr);
+/// Draws every plot into `directory`/figures (NAME.svg, NAME.pdf).  Returns the reason
+/// when nothing could be drawn (gnuplot missing or failing), else nothing.
+std::optional<std::string> render_figures(const std::vector<Plot>& plots, const std::filesystem::path& directory);
 
-/// The errata ledgers (reports/errata/*.toml) as one Markdown document.
-std::string errata_markdown(const std::string& errata_directory);
+/// The figure's data as CSV: series,x,y (one row per finite point).
+std::string figure_csv(const Plot& plot);
+
+/// True when every series has at least one finite point.
+bool has_data(const Plot& plot);
 
 }  // namespace backlash::reports

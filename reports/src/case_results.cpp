@@ -1,0 +1,586 @@
+// The numbers of one case (derivation, validation, dividing lines, trajectories,
+// limit cycle, describing function) and its figures.
+#include "report_parts.hpp"
+
+#include "backlash/codegen/emit.hpp"
+#include "backlash/symbolic/pretty.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <stdexcept>
+
+namespace backlash::reports {
+
+namespace {
+constexpr double nan_value = std::numeric_limits<double>::quiet_NaN();
+
+bool series_has_data(const Series& s) {
+  for (std::size_t k = 0; k < s.x.size() && k < s.y.size(); ++k)
+    if (std::isfinite(s.x[k]) && std::isfinite(s.y[k])) return true;
+  return false;
+}
+}
+
+std::string fixed(double v, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, v);
+  std::string s = buffer;
+  if (s.rfind("-0.", 0) == 0 && std::strtod(s.c_str(), nullptr) == 0) s.erase(0, 1);
+  return s;
+}
+
+std::string sig(double v, int significant) { return symbolic::pretty::decimal(v, significant, symbolic::pretty::Style::Text); }
+
+std::string roman_to_anchor(const std::string& id) {
+  std::string out = "case-";
+  for (char c : id) out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return out;
+}
+
+const ThesisCase& ThesisData::thesis_case(const std::string& id) const {
+  for (const ThesisCase& c : cases)
+    if (c.id == id) return c;
+  throw std::runtime_error("reports/data/thesis_cases.toml has no case " + id);
+}
+
+ThesisData load_thesis_data(const DataPaths& paths) {
+  ThesisData d;
+  d.errata = load_errata(paths.errata_directory);
+  d.cases = load_thesis_cases(paths.data_directory / "thesis_cases.toml");
+  d.figures = load_figures(paths.data_directory / "thesis_figures.toml");
+  d.step_points = load_step_points(paths.data_directory / "thesis_step_tables.toml");
+  d.dividing_line_cells = load_dividing_line_cells(paths.dividing_line_tables);
+  return d;
+}
+
+std::string figure_name(const FigureSpec& spec) {
+  char number[8];
+  std::snprintf(number, sizeof number, "%02d", spec.number);
+  std::string kind = spec.kind == "phase"        ? "phase_plane"
+                     : spec.kind == "separation" ? "separation"
+                     : spec.kind == "transient"  ? "transient_response"
+                     : spec.sweep == "fig31"     ? "magnitude_vs_friction_ratio"
+                                                 : "magnitude_vs_inertia_ratio";
+  return std::string("fig") + number + (spec.case_id.empty() ? "" : "_case" + spec.case_id) + "_" + kind;
+}
+
+std::vector<const FigureSpec*> figures_of(const ThesisData& data, const std::string& case_id) {
+  std::vector<const FigureSpec*> out;
+  for (const FigureSpec& f : data.figures)
+    if (f.case_id == case_id) out.push_back(&f);
+  return out;
+}
+
+// ---------------------------------------------------------------- computing a case
+
+CaseResult compute_case(const std::string& id, const ThesisData& data) {
+  CaseResult c;
+  c.spec = model::load_case(id);
+  c.thesis = &data.thesis_case(id);
+  c.derivation = symbolic::derive_case(c.spec);
+  c.validation = numeric::validate(numeric::case_evaluator(c.spec));
+  if (!c.validation.passed()) {
+    std::string failing;
+    for (const numeric::StateError& s : c.validation.report().states)
+      if (!s.passed) failing += (failing.empty() ? "" : ", ") + s.state;
+    throw std::runtime_error("case " + id + ": the evaluator failed validation against odeint (" + failing + ")");
+  }
+  const numeric::ValidatedEvaluator& ev = c.evaluator();
+  c.parameters = ev.parameters();
+  const numeric::Parameters& p = c.parameters;
+
+  std::vector<double> grid, negative;
+  for (int k = 0; k <= 120; ++k) grid.push_back(0.01 * std::pow(150.0, k / 120.0));
+  for (double v : grid) negative.push_back(-v);
+  c.lines_positive = numeric::trace_dividing_lines(ev, grid);
+  c.lines_negative = numeric::trace_dividing_lines(ev, negative);
+
+  numeric::SimulationOptions options;
+  options.t_end = 60;
+  options.sample_interval = 0.01;
+  if (c.spec.experiment) {
+    if (c.spec.experiment->t_end) options.t_end = model::to_double(*c.spec.experiment->t_end);
+    TrajectoryRun run;
+    run.step = model::to_double(c.spec.experiment->step);
+    run.label = "step " + sig(run.step, 6);
+    run.source = "the case file's [experiment]";
+    run.result = numeric::simulate_step(ev, run.step, options);
+    c.runs.push_back(std::move(run));
+  }
+  for (const Trajectory& t : c.thesis->trajectories) {
+    TrajectoryRun run;
+    run.source = t.quote;
+    if (t.kind == "step") {
+      run.step = printed_number(t.step);
+      run.label = "step " + sig(run.step, 6);
+      run.result = numeric::simulate_step(ev, run.step, options);
+    } else if (t.kind == "state") {
+      run.is_step = false;
+      run.theta_o0 = printed_number(t.theta_o);
+      run.dtheta_o0 = printed_number(t.dtheta_o);
+      run.label = "start (" + sig(run.theta_o0, 6) + ", " + sig(run.dtheta_o0, 6) + ")";
+      const numeric::HybridState start =
+          numeric::state_on_face(p, run.dtheta_o0 > 0 ? -1 : +1, run.theta_o0, run.dtheta_o0, false);
+      run.result = numeric::simulate(ev, start, options);
+    } else {
+      throw std::runtime_error("thesis_cases.toml: case " + id + ": unknown trajectory kind '" + t.kind + "'");
+    }
+    c.runs.push_back(std::move(run));
+  }
+
+  c.cycle = numeric::find_limit_cycle(ev);
+  if (c.cycle.status == "limit_cycle") {
+    const double v = c.cycle.separation_velocity;
+    const numeric::HybridState start = numeric::state_on_face(p, -1, p.theta_R + ev.cot_phi() * v, v, false);
+    numeric::SimulationOptions o;
+    o.t_end = c.cycle.period;
+    o.sample_interval = c.cycle.period / 800;
+    const numeric::SimulationResult r = numeric::simulate(ev, start, o);
+    c.cycle_orbit = r.samples;
+    if (!c.cycle_orbit.empty()) c.cycle_orbit.push_back(c.cycle_orbit.front());  // close the orbit
+  }
+  c.describing_function = describing_function_prediction(p);
+  c.generated_header = codegen::emit_case_header(c.spec, c.derivation);
+  return c;
+}
+
+// ---------------------------------------------------------------- figures
+
+namespace {
+
+struct Window {
+  double x0, x1, y0, y1;
+};
+
+void extend(Window& w, double x, double y) {
+  if (!std::isfinite(x) || !std::isfinite(y)) return;
+  w.x0 = std::min(w.x0, x);
+  w.x1 = std::max(w.x1, x);
+  w.y0 = std::min(w.y0, y);
+  w.y1 = std::max(w.y1, y);
+}
+
+// The part of the line through (x, y) with direction (dx, dy) inside the window (Liang–Barsky).
+bool clip_line(const Window& w, double x, double y, double dx, double dy, double& ax, double& ay, double& bx, double& by) {
+  double t0 = -1e300, t1 = 1e300;
+  const double p[4] = {-dx, dx, -dy, dy};
+  const double q[4] = {x - w.x0, w.x1 - x, y - w.y0, w.y1 - y};
+  for (int i = 0; i < 4; ++i) {
+    if (p[i] == 0) {
+      if (q[i] < 0) return false;
+      continue;
+    }
+    const double r = q[i] / p[i];
+    if (p[i] < 0) t0 = std::max(t0, r);
+    else t1 = std::min(t1, r);
+  }
+  if (t0 > t1) return false;
+  ax = x + t0 * dx;
+  ay = y + t0 * dy;
+  bx = x + t1 * dx;
+  by = y + t1 * dy;
+  return true;
+}
+
+const char* color_motor = "#1f5fbf";
+const char* color_load = "#2a9d3a";
+const char* color_recombined = "#d62728";
+const char* trajectory_colors[] = {"#7b3294", "#e66101", "#008b8b", "#8c564b"};
+
+std::string shaft_name(const numeric::Parameters& p, bool measured) {
+  const bool motor = (p.measured_at == model::MeasuredAt::Motor) == measured;
+  return motor ? "motor" : "load";
+}
+
+// θ of the shaft that is not measured, during free flight, in the thesis's convention
+// (θm = θL at separation): offset so it starts where θo was at the separation.
+Series other_shaft_during_separation(const numeric::SimulationResult& r, const numeric::Parameters& p, const std::string& label,
+                                     const std::string& style) {
+  Series s{label, {}, {}, style};
+  const bool at_motor = p.measured_at == model::MeasuredAt::Motor;
+  bool in_run = false;
+  double offset = 0;
+  for (const numeric::TrajectorySample& x : r.samples) {
+    if (x.in_contact) {
+      if (in_run) {
+        s.x.push_back(nan_value);
+        s.y.push_back(nan_value);
+      }
+      in_run = false;
+      continue;
+    }
+    const double other = at_motor ? x.theta_L : x.theta_m, dother = at_motor ? x.dtheta_L : x.dtheta_m;
+    if (!in_run) offset = x.theta_o - other;
+    in_run = true;
+    s.x.push_back(other + offset);
+    s.y.push_back(dother);
+  }
+  return s;
+}
+
+Plot phase_plot(const CaseResult& c, const FigureSpec& spec) {
+  const numeric::Parameters& p = c.parameters;
+  const double theta_R = p.theta_R;
+  Plot plot;
+  plot.name = figure_name(spec);
+  plot.title = "Thesis fig. " + std::to_string(spec.number) + ": case " + c.spec.id + ", phase plane θ_{o} vs θ̇_{o}";
+  plot.x_label = "θ_{o}, the " + shaft_name(p, true) + " (rad)";
+  plot.y_label = "θ̇_{o} (rad/s)";
+  plot.width = 1000;
+  plot.height = 940;
+  plot.key = "outside below center horizontal maxcols 2 samplen 2.5 font ',10'";
+  std::vector<const TrajectoryRun*> runs;
+  for (const std::string& which : spec.trajectories) {
+    if (which == "experiment" && !c.runs.empty()) runs.push_back(&c.runs.front());
+    if (which == "second")
+      for (std::size_t k = 1; k < c.runs.size(); ++k) runs.push_back(&c.runs[k]);
+  }
+  // each trajectory up to its sixth separation (enough to show it approach the cycle)
+  std::vector<double> cut;
+  for (const TrajectoryRun* r : runs) {
+    double t_cut = r->result.t_final;
+    int separations = 0;
+    for (const numeric::SimulationEvent& e : r->result.events)
+      if (e.kind == numeric::EventKind::Separation && ++separations == 6) {
+        t_cut = e.t;
+        break;
+      }
+    cut.push_back(t_cut);
+  }
+  Window w{theta_R, theta_R, 0, 0};
+  for (std::size_t k = 0; k < runs.size(); ++k)
+    for (const numeric::TrajectorySample& s : runs[k]->result.samples)
+      if (s.t <= cut[k]) extend(w, s.theta_o, s.dtheta_o);
+  for (const numeric::TrajectorySample& s : c.cycle_orbit) extend(w, s.theta_o, s.dtheta_o);
+  const double dx = std::max(w.x1 - w.x0, 0.2), dy = std::max(w.y1 - w.y0, 0.2);
+  w.x0 -= 0.08 * dx;
+  w.x1 += 0.08 * dx;
+  w.y0 -= 0.08 * dy;
+  w.y1 += 0.08 * dy;
+  plot.x_range = std::pair{w.x0, w.x1};
+  plot.y_range = std::pair{w.y0, w.y1};
+
+  // isoclines of the combined system through (θR, 0)
+  Series iso{"isoclines of the combined system (η = θ̈_{o}/θ̇_{o})", {}, {}, "lines lw 1 lc rgb '#c8c8c8'"};
+  const symbolic::IsoclineTable& table = c.derivation.isoclines.front();
+  for (const symbolic::IsoclineRow& row : table.rows) {
+    double ax, ay, bx, by;
+    const bool ok = row.is_vertical ? clip_line(w, theta_R, 0, 0, 1, ax, ay, bx, by)
+                                    : clip_line(w, theta_R, 0, 1, symbolic::to_double(row.tangent, {}), ax, ay, bx, by);
+    if (!ok) continue;
+    iso.x.insert(iso.x.end(), {ax, bx, nan_value});
+    iso.y.insert(iso.y.end(), {ay, by, nan_value});
+    const double eta = row.is_infinite ? 0 : symbolic::to_double(row.eta, {});
+    const bool labelled = row.is_infinite || row.is_vertical ||
+                          std::fabs(std::fabs(eta) - 1) < 1e-12 || std::fabs(std::fabs(eta) - 2) < 1e-12 ||
+                          std::fabs(std::fabs(eta) - 5) < 1e-12 || std::fabs(eta) < 1e-12 || std::fabs(std::fabs(eta) - 0.5) < 1e-12;
+    if (labelled) {
+      const bool upper = by > ay || (by == ay && bx > ax);
+      const double lx = upper ? bx : ax, ly = upper ? by : ay;
+      const std::string text = row.is_infinite ? "η=∞" : "η=" + symbolic::pretty::decimal(eta, 4, symbolic::pretty::Style::Text);
+      const double x = theta_R + 0.9 * (lx - theta_R), y = 0.9 * ly;
+      bool crowded = false;
+      for (const Label& other : plot.labels)
+        crowded = crowded || (std::fabs(other.x - x) < 0.07 * (w.x1 - w.x0) && std::fabs(other.y - y) < 0.04 * (w.y1 - w.y0));
+      if (!crowded) plot.labels.push_back({text, x, y});
+    }
+  }
+  plot.series.push_back(iso);
+  // separation line, one half per face
+  const double cot_phi = c.evaluator().cot_phi();
+  plot.series.push_back({"separation line, face −b/2 (θ̇_{o} > 0)", {theta_R, theta_R + cot_phi * w.y1}, {0, w.y1},
+                         "lines lw 2 dt 2 lc rgb '#000000'"});
+  plot.series.push_back({"separation line, face +b/2 (θ̇_{o} < 0)", {theta_R, theta_R + cot_phi * w.y0}, {0, w.y0},
+                         "lines lw 2 dt 3 lc rgb '#555555'"});
+  // recombination loci of both faces
+  Series motor{"motor before recombination (θ_{m}, θ̇_{m}), both faces", {}, {}, std::string("linespoints lw 1 pt 7 ps 0.35 lc rgb '") + color_motor + "'"};
+  Series load{"load before recombination (θ_{L}, θ̇_{L}), both faces", {}, {}, std::string("linespoints lw 1 pt 5 ps 0.35 lc rgb '") + color_load + "'"};
+  Series recombined{"after the impact (θ_{o}, θ̇_{o}; eq. 24), both faces", {}, {},
+                    std::string("linespoints lw 1.5 pt 9 ps 0.45 lc rgb '") + color_recombined + "'"};
+  for (const numeric::DividingLines* lines : {&c.lines_positive, &c.lines_negative}) {
+    for (const numeric::DividingLinePoint& q : lines->points) {
+      if (q.status == numeric::RecombinationStatus::NoRecombination) continue;
+      motor.x.push_back(q.theta_m);
+      motor.y.push_back(q.dtheta_m);
+      load.x.push_back(q.theta_L);
+      load.y.push_back(q.dtheta_L);
+      recombined.x.push_back(q.theta_o);
+      recombined.y.push_back(q.dtheta_o);
+    }
+    for (Series* s : {&motor, &load, &recombined}) {
+      s->x.push_back(nan_value);
+      s->y.push_back(nan_value);
+    }
+  }
+  plot.series.push_back(motor);
+  plot.series.push_back(load);
+  plot.series.push_back(recombined);
+  // trajectories
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const char* color = trajectory_colors[k % 4];
+    Series s{runs[k]->label + ": θ_{o}", {}, {}, std::string("lines lw 1.6 lc rgb '") + color + "'"};
+    numeric::SimulationResult shown = runs[k]->result;
+    shown.samples.erase(std::remove_if(shown.samples.begin(), shown.samples.end(),
+                                       [&](const numeric::TrajectorySample& x) { return x.t > cut[k]; }),
+                        shown.samples.end());
+    for (const numeric::TrajectorySample& x : shown.samples) {
+      s.x.push_back(x.theta_o);
+      s.y.push_back(x.dtheta_o);
+    }
+    plot.series.push_back(s);
+    Series other = other_shaft_during_separation(shown, p, runs[k]->label + ": " + shaft_name(p, false) + " during separation",
+                                                 std::string("lines lw 1 dt 4 lc rgb '") + color + "'");
+    if (series_has_data(other)) plot.series.push_back(other);
+  }
+  if (!c.cycle_orbit.empty()) {
+    Series s{"limit cycle (exact)", {}, {}, "lines lw 3.5 lc rgb '#000000'"};
+    for (const numeric::TrajectorySample& x : c.cycle_orbit) {
+      s.x.push_back(x.theta_o);
+      s.y.push_back(x.dtheta_o);
+    }
+    plot.series.push_back(s);
+  }
+  plot.series.push_back({"θ_{R}", {theta_R}, {0}, "points pt 6 ps 1.5 lc rgb '#000000'"});
+  return plot;
+}
+
+Plot separation_plot(const CaseResult& c, const FigureSpec& spec) {
+  const numeric::Parameters& p = c.parameters;
+  const double v = printed_number(spec.dtheta_m0), t_end = printed_number(spec.t_end);
+  Plot plot;
+  plot.name = figure_name(spec);
+  const std::string v_text = sig(v, 6);
+  plot.title = "Thesis fig. " + std::to_string(spec.number) + ": case " + c.spec.id + ", θ_{m} and θ_{L} during separation (θ̇_{m0} = " + v_text + ")";
+  plot.x_label = "t, time since the separation (s)";
+  plot.key = "inside left top font ',10'";
+  plot.y_label = "displacement from θ_{R} (rad)";
+  Series m{"θ_{m} − θ_{R}, motor", {}, {}, std::string("lines lw 2 lc rgb '") + color_motor + "'"};
+  Series l{"θ_{L} − θ_{R}, load", {}, {}, std::string("lines lw 2 lc rgb '") + color_load + "'"};
+  Series gap{"θ_{L} − θ_{m} per unit θ̇_{m0} (the gap)", {}, {}, "lines lw 1.5 dt 2 lc rgb '#444444'"};
+  const int n = 600;
+  for (int k = 0; k <= n; ++k) {
+    const double t = t_end * k / n;
+    const numeric::FreeState s = c.evaluator().free_state(t, v);
+    m.x.push_back(t);
+    m.y.push_back(s.theta_m - p.theta_R);
+    l.x.push_back(t);
+    l.y.push_back(s.theta_L - p.theta_R);
+    gap.x.push_back(t);
+    gap.y.push_back(s.gap / v);
+  }
+  plot.series.push_back(m);
+  plot.series.push_back(l);
+  const numeric::DividingLinePoint at = numeric::dividing_line_point(c.evaluator(), v);
+  if (at.status == numeric::RecombinationStatus::Recombination && at.t <= t_end) {
+    plot.series.push_back({"recombination (gap = b) at t = " + fixed(at.t, 4), {at.t, at.t}, {at.theta_m - p.theta_R, at.theta_L - p.theta_R},
+                           "linespoints lw 1 dt 3 pt 7 ps 1.2 lc rgb '#d62728'"});
+  }
+  if (!spec.dividers.empty()) {
+    plot.series.push_back(gap);
+    Series levels{"b/θ̇_{m0}: the divider setting for θ̇_{m0}", {}, {}, "lines lw 1 lc rgb '#999999'"};
+    Series hits{"recombination times read off (certified crossings)", {}, {}, "points pt 7 ps 1.2 lc rgb '#d62728'"};
+    for (const std::string& d : spec.dividers) {
+      const double vd = printed_number(d);
+      const double level = p.backlash / vd;
+      levels.x.insert(levels.x.end(), {0, t_end, nan_value});
+      levels.y.insert(levels.y.end(), {level, level, nan_value});
+      plot.labels.push_back({"θ̇_{m0} = " + sig(vd, 4), 0.02 * t_end, level + 0.0});
+      const numeric::DividingLinePoint q = numeric::dividing_line_point(c.evaluator(), vd);
+      if (q.status == numeric::RecombinationStatus::Recombination && q.t <= t_end) {
+        hits.x.push_back(q.t);
+        hits.y.push_back(level);
+        plot.labels.push_back({"t = " + fixed(q.t, 3), q.t + 0.02 * t_end, level + 0.0});
+      }
+    }
+    plot.series.push_back(levels);
+    if (!hits.x.empty()) plot.series.push_back(hits);
+  }
+  return plot;
+}
+
+// θL in the thesis's frame during free flight (measured from the face left at the last separation).
+double thesis_frame_load(const numeric::SimulationResult& r, const numeric::Parameters& p, double t, double theta_L) {
+  int face = -1;
+  for (const numeric::SimulationEvent& e : r.events) {
+    if (e.t > t) break;
+    if (e.kind == numeric::EventKind::Separation) face = e.after.face;
+  }
+  return theta_L - face * p.backlash / 2;
+}
+
+Plot transient_plot(const CaseResult& c, const FigureSpec* spec, const ThesisData& data) {
+  const numeric::Parameters& p = c.parameters;
+  Plot plot;
+  if (spec) {
+    plot.name = figure_name(*spec);
+    plot.title = "Thesis fig. " + std::to_string(spec->number) + ": case " + c.spec.id + ", transient response";
+  } else {
+    plot.name = "case" + c.spec.id + "_step_responses";
+    plot.title = "Case " + c.spec.id + ": the thesis's step inputs (no transient figure in the thesis)";
+  }
+  plot.x_label = "t (s)";
+  plot.y_label = "θ_{o} − θ_{o}(0), displacement from the start (rad)";
+  plot.key = "bottom right";
+  double t_max = 0;
+  std::vector<const TrajectoryRun*> runs;
+  if (spec) {
+    for (const std::string& which : spec->trajectories) {
+      if (which == "experiment" && !c.runs.empty()) runs.push_back(&c.runs.front());
+      if (which == "second")
+        for (std::size_t k = 1; k < c.runs.size(); ++k) runs.push_back(&c.runs[k]);
+    }
+  } else {
+    for (const TrajectoryRun& r : c.runs) runs.push_back(&r);
+  }
+  // the thesis's printed points (and how far they go)
+  std::vector<Series> printed;
+  for (const TrajectoryRun* run : runs) {
+    if (!run->is_step) continue;
+    Series main{"", {}, {}, "points pt 6 ps 1.3 lc rgb '#000000'"}, load{"", {}, {}, "points pt 4 ps 1.3 lc rgb '#2a9d3a'"};
+    for (const StepPoint& sp : data.step_points) {
+      if (sp.case_id != c.spec.id || std::fabs(printed_number(sp.step) - run->step) > 1e-12) continue;
+      main.label = sp.table + " (printed): θ_{o}, θ_{m}";
+      load.label = sp.table + " (printed): θ_{L}, thesis's frame";
+      const double t = printed_number(sp.t), y = printed_number(sp.printed);
+      const double start = sp.quantity == "theta_o - theta_o(0)" ? 0.0 : (p.theta_R - run->step);
+      t_max = std::max(t_max, t);
+      if (sp.quantity == "theta_L") {
+        load.x.push_back(t);
+        load.y.push_back(y - start);
+      } else {
+        main.x.push_back(t);
+        main.y.push_back(y - start);
+      }
+    }
+    if (!main.x.empty()) printed.push_back(main);
+    if (!load.x.empty()) printed.push_back(load);
+  }
+  const double t_end = t_max > 0 ? std::max(2 * t_max, 10.0) : 40.0;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const char* color = trajectory_colors[k % 4];
+    const double start = runs[k]->result.samples.empty() ? 0 : runs[k]->result.samples.front().theta_o;
+    Series s{runs[k]->label + ": θ_{o} − θ_{o}(0)", {}, {}, std::string("lines lw 2 lc rgb '") + color + "'"};
+    Series l{runs[k]->label + ": θ_{L} during separation, thesis's frame", {}, {}, std::string("lines lw 1.2 dt 2 lc rgb '") + color + "'"};
+    bool was_free = false;
+    for (const numeric::TrajectorySample& x : runs[k]->result.samples) {
+      if (x.t > t_end) break;
+      s.x.push_back(x.t);
+      s.y.push_back(x.theta_o - start);
+      if (!x.in_contact && p.measured_at == model::MeasuredAt::Motor) {
+        l.x.push_back(x.t);
+        l.y.push_back(thesis_frame_load(runs[k]->result, p, x.t, x.theta_L) - start);
+        was_free = true;
+      } else if (was_free) {
+        l.x.push_back(nan_value);
+        l.y.push_back(nan_value);
+        was_free = false;
+      }
+    }
+    plot.series.push_back(s);
+    if (k == 0 && !printed.empty() && series_has_data(l)) plot.series.push_back(l);
+  }
+  for (Series& s : printed) plot.series.push_back(s);
+  plot.x_range = std::pair{0.0, t_end};
+  return plot;
+}
+
+}  // namespace
+
+std::vector<Plot> case_figures(const CaseResult& c, const ThesisData& data) {
+  std::vector<Plot> plots;
+  bool has_transient = false;
+  for (const FigureSpec* spec : figures_of(data, c.spec.id)) {
+    if (spec->kind == "phase") plots.push_back(phase_plot(c, *spec));
+    else if (spec->kind == "separation") plots.push_back(separation_plot(c, *spec));
+    else if (spec->kind == "transient") {
+      plots.push_back(transient_plot(c, spec, data));
+      has_transient = true;
+    } else {
+      throw std::runtime_error("thesis_figures.toml: figure " + std::to_string(spec->number) + ": unknown kind '" + spec->kind + "'");
+    }
+  }
+  if (!has_transient) plots.push_back(transient_plot(c, nullptr, data));
+  return plots;
+}
+
+// ---------------------------------------------------------------- sweeps
+
+std::vector<SweepResult> compute_sweeps() {
+  std::vector<SweepResult> out;
+  numeric::SweepOptions options;
+  out.push_back({"fig31", numeric::run_sweep(numeric::figure31_points(101), options)});
+  out.push_back({"fig32", numeric::run_sweep(numeric::figure32_points(79), options)});
+  return out;
+}
+
+namespace {
+
+bool same_parameters(const numeric::Parameters& a, const numeric::Parameters& b) {
+  const auto close = [](double x, double y) { return std::fabs(x - y) <= 1e-9 * std::max(1.0, std::fabs(y)); };
+  return a.measured_at == b.measured_at && close(a.Jm, b.Jm) && close(a.Fm, b.Fm) && close(a.JL, b.JL) && close(a.FL, b.FL) &&
+         close(a.K, b.K) && close(a.theta_R, b.theta_R) && close(a.backlash, b.backlash);
+}
+
+}  // namespace
+
+std::vector<Plot> sweep_figures(const std::vector<SweepResult>& sweeps, const std::vector<CaseResult>& cases,
+                                const ThesisData& data) {
+  std::vector<Plot> plots;
+  for (const SweepResult& sweep : sweeps) {
+    const FigureSpec* spec = nullptr;
+    for (const FigureSpec& f : data.figures)
+      if (f.kind == "sweep" && f.sweep == sweep.name) spec = &f;
+    if (!spec) throw std::runtime_error("thesis_figures.toml has no figure for sweep " + sweep.name);
+    Plot plot;
+    plot.name = figure_name(*spec);
+    plot.title = "Thesis fig. " + std::to_string(spec->number) + ": limit-cycle magnitude (peak-to-peak of θ_{o}) vs " +
+                 (sweep.name == "fig31" ? "F_{L}/F" : "J_{L}/J_{m}");
+    plot.x_label = sweep.name == "fig31" ? "F_{L}/F, load friction over total friction F = F_{m} + F_{L} (ratio)"
+                                         : "J_{L}/J_{m}, load inertia over motor inertia (ratio)";
+    plot.y_label = "magnitude: peak-to-peak of θ_{o} on the cycle (rad)";
+    plot.width = 1000;
+    plot.key = "inside right top font ',10'";
+    std::vector<std::string> order;
+    std::map<std::string, Series> series;
+    for (const numeric::SweepRow& row : sweep.rows) {
+      if (!series.count(row.point.series)) {
+        order.push_back(row.point.series);
+        series[row.point.series] = Series{"exact, " + row.point.series, {}, {}, ""};
+      }
+      Series& s = series[row.point.series];
+      s.x.push_back(row.point.x);
+      s.y.push_back(row.status == "limit_cycle" ? row.cycle.peak_to_peak : nan_value);
+    }
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      Series s = series[order[k]];
+      s.style = std::string("lines lw 2 lc rgb '") + trajectory_colors[k % 4] + "'";
+      plot.series.push_back(s);
+    }
+    Series thesis{"the thesis's magnitudes (section 14) at its cases", {}, {}, "points pt 7 ps 1.8 lc rgb '#d62728'"};
+    Series exact{"exact magnitudes at those cases", {}, {}, "points pt 6 ps 2.2 lw 2 lc rgb '#000000'"};
+    for (const CaseResult& c : cases) {
+      if (c.thesis->limit_cycle_printed == "none") continue;
+      for (const numeric::SweepRow& row : sweep.rows) {
+        if (!same_parameters(row.point.parameters, c.parameters)) continue;
+        thesis.x.push_back(row.point.x);
+        thesis.y.push_back(printed_number(c.thesis->limit_cycle_printed));
+        exact.x.push_back(row.point.x);
+        exact.y.push_back(c.cycle.peak_to_peak);
+        plot.labels.push_back({"  case " + c.spec.id, row.point.x + 0.01 * (sweep.rows.back().point.x - sweep.rows.front().point.x),
+                               printed_number(c.thesis->limit_cycle_printed)});
+        break;
+      }
+    }
+    if (!thesis.x.empty()) {
+      plot.series.push_back(thesis);
+      plot.series.push_back(exact);
+    }
+    plots.push_back(plot);
+  }
+  return plots;
+}
+
+}  // namespace backlash::reports

@@ -1,0 +1,172 @@
+#include "backlash/symbolic/derivation_steps.hpp"
+
+#include <stdexcept>
+
+namespace backlash::symbolic {
+
+using namespace GiNaC;
+
+namespace {
+
+numeric factorial_of(unsigned n) { return factorial(numeric(n)); }
+
+}  // namespace
+
+SegmentSteps segment_steps(const Segment& segment, const RadicalList& radicals) {
+  SegmentSteps steps;
+  const symbol& s = derivation_symbols().s;
+  steps.transform = pretty::rational_function(segment.laplace, s);
+  const ex numerator = steps.transform.numerator, denominator = steps.transform.denominator;
+
+  RadicalList known = radicals;
+  std::vector<Pole> poles = find_poles(denominator, s, known, "omega", "");
+  // factor() returns its factors in GiNaC's hash order and with either sign: give each a
+  // leading coefficient (in s) whose first printed term is positive, and sort them (real poles
+  // first, then by value)
+  for (Pole& p : poles) {
+    const ex lc = p.factor.coeff(s, p.factor.degree(s));
+    if (pretty::text(lc).rfind("-", 0) == 0) p.factor = expand(-p.factor);
+  }
+  {
+    struct Keyed {
+      Pole pole;
+      int kind;
+      double value;
+      std::string text;
+    };
+    std::vector<Keyed> keyed;
+    for (const Pole& p : poles) {
+      Keyed k{p, static_cast<int>(p.kind), 0.0, pretty::text(p.center)};
+      try {
+        k.value = to_double(p.center, known);
+      } catch (...) {
+        k.value = 0.0;
+      }
+      keyed.push_back(k);
+    }
+    std::stable_sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
+      if (a.kind != b.kind) return a.kind < b.kind;
+      if (a.value != b.value) return a.value > b.value;
+      return a.text < b.text;
+    });
+    poles.clear();
+    for (const Keyed& k : keyed) poles.push_back(k.pole);
+  }
+  RadicalList with_i = known;
+  with_i.push_back(imaginary_unit());
+  steps.radicals = known;
+  const symbol& i = imaginary_unit().symbol;
+
+  ex product = 1;
+  for (const Pole& p : poles) {
+    steps.factors.emplace_back(p.factor, p.multiplicity);
+    product *= pow(p.factor, p.multiplicity);
+  }
+  steps.leading_constant = normal(denominator / expand(product));
+
+  std::vector<ExpTerm> terms;
+  ex partial_sum = 0;
+  for (const Pole& pole : poles) {
+    PoleResidues row;
+    row.pole = pole;
+    const unsigned m = pole.multiplicity;
+    const ex factor_power = expand(pow(pole.factor, m));
+    const ex rest = quo(expand(denominator), factor_power, s, false);
+    const ex leading = pole.factor.coeff(s, pole.factor.degree(s));
+    std::vector<std::pair<ex, ex>> locations;  // (p, partner)
+    switch (pole.kind) {
+      case Pole::Kind::Real: locations.push_back({pole.center, 0}); break;
+      case Pole::Kind::RealPair:
+        locations.push_back({pole.center + pole.half_width, pole.center - pole.half_width});
+        locations.push_back({pole.center - pole.half_width, pole.center + pole.half_width});
+        break;
+      case Pole::Kind::ComplexPair:
+        locations.push_back({pole.center + i * pole.half_width, pole.center - i * pole.half_width});
+        break;
+    }
+    for (const auto& [p, partner] : locations) {
+      PoleResidues::Location location{p, {}};
+      ex H = numerator / (pow(leading, m) * rest);
+      if (pole.kind != Pole::Kind::Real) H = H / pow(s - partner, m);
+      std::vector<ex> derivatives{H};
+      for (unsigned j = 1; j < m; ++j) derivatives.push_back(derivatives.back().diff(s));
+      location.coefficients.resize(m);
+      for (unsigned r = 1; r <= m; ++r) {
+        const unsigned j = m - r;
+        const ex A = simplify(derivatives[j].subs(s == p) / factorial_of(j), with_i);
+        location.coefficients[r - 1] = A;
+        const ex time_coefficient = A / factorial_of(r - 1);
+        if (pole.kind == Pole::Kind::ComplexPair) {
+          const ex conjugate_A = A.subs(i == -i), conjugate_p = p.subs(i == -i);
+          partial_sum += A / pow(s - p, r) + conjugate_A / pow(s - conjugate_p, r);
+          const ex real_part = simplify(time_coefficient.subs(i == 0), with_i);
+          const ex imag_part = simplify(time_coefficient.coeff(i, 1), with_i);
+          terms.push_back({2 * real_part, r - 1, pole.center, Oscillation::Cos, pole.half_width});
+          terms.push_back({-2 * imag_part, r - 1, pole.center, Oscillation::Sin, pole.half_width});
+        } else {
+          partial_sum += A / pow(s - p, r);
+          terms.push_back({time_coefficient, r - 1, p, Oscillation::None, 0});
+        }
+      }
+      row.locations.push_back(std::move(location));
+    }
+    steps.poles.push_back(std::move(row));
+  }
+  steps.from_residues = TimeFunction(std::move(terms)).combined(known);
+  steps.partial_fractions_sum_to_transform = is_exactly_zero(partial_sum - segment.laplace, with_i);
+  steps.residues_give_solution = (steps.from_residues - segment.solution).is_zero(known);
+  return steps;
+}
+
+std::string pole_latex(const Pole& pole, const RadicalList& radicals) {
+  const std::string center = pretty::latex(with_explicit_radicals(pole.center, radicals));
+  if (pole.kind == Pole::Kind::Real) return center;
+  const std::string width =
+      is_a<symbol>(pole.half_width) ? pretty::latex_symbol_name(ex_to<symbol>(pole.half_width).get_name())
+                                    : pretty::latex(with_explicit_radicals(pole.half_width, radicals));
+  const std::string prefix = center == "0" ? "" : center + " ";
+  if (pole.kind == Pole::Kind::ComplexPair) return prefix + "\\pm \\mathrm{i}\\," + width;
+  return prefix + "\\pm " + width;
+}
+
+std::vector<pretty::Summand> partial_fraction_terms(const SegmentSteps& steps, const pretty::Format& format) {
+  const symbol& s = derivation_symbols().s;
+  std::vector<pretty::Summand> out;
+  for (const PoleResidues& row : steps.poles) {
+    const Pole& pole = row.pole;
+    if (pole.kind == Pole::Kind::ComplexPair && pole.multiplicity == 1) {
+      // A/(s − p) + Ā/(s − p̄) = (P (s − α) + Q ω)/((s − α)² + ω²), P = 2 Re A, Q = −2 Im A
+      const symbol& i = imaginary_unit().symbol;
+      const ex A = row.locations.front().coefficients.front();
+      const ex P = simplify(2 * A.subs(i == 0), steps.radicals);
+      const ex Q = simplify(-2 * A.coeff(i, 1), steps.radicals);
+      const std::string shifted = pretty::latex(s - with_explicit_radicals(pole.center, steps.radicals));
+      const std::string omega = is_a<symbol>(pole.half_width)
+                                    ? pretty::latex_symbol_name(ex_to<symbol>(pole.half_width).get_name())
+                                    : pretty::latex(with_explicit_radicals(pole.half_width, steps.radicals));
+      const std::string quadratic = "\\left(" + shifted + "\\right)^{2} + " + omega + "^{2}";
+      for (const auto& [coefficient, top] : {std::pair{P, shifted}, std::pair{Q, omega}}) {
+        if (coefficient.is_zero()) continue;
+        const pretty::Summand c = pretty::factor(with_explicit_radicals(coefficient, steps.radicals), format);
+        const std::string body = (c.body == "1" ? "" : c.body) + "\\frac{" + top + "}{" + quadratic + "}";
+        out.push_back({c.negative, body});
+      }
+      continue;
+    }
+    for (const PoleResidues::Location& location : row.locations) {
+      const std::string base = pretty::latex(s - with_explicit_radicals(location.at, steps.radicals));
+      for (std::size_t r = location.coefficients.size(); r >= 1; --r) {
+        const ex& A = location.coefficients[r - 1];
+        if (A.is_zero()) continue;
+        std::string denominator = base == "s" ? "s" : (r > 1 ? "\\left(" + base + "\\right)" : base);
+        if (r > 1) denominator += "^{" + std::to_string(r) + "}";
+        const pretty::Summand c = pretty::factor(with_explicit_radicals(A, steps.radicals), format);
+        out.push_back({c.negative, (c.body == "1" ? "" : c.body) + "\\frac{1}{" + denominator + "}"});
+      }
+    }
+  }
+  if (out.empty()) out.push_back({false, "0"});
+  return out;
+}
+
+}  // namespace backlash::symbolic
