@@ -31,7 +31,7 @@ void run_discrepancy(const DiscrepancyOptions& o) {
   if (o.step) {
     step = parse_number(*o.step, "--step");
     if (step == 0) throw UsageError("--step: must not be 0");
-  } else if (spec.experiment) {
+  } else if (spec.experiment && spec.experiment->kind == model::ExperimentKind::Step) {
     step = model::to_double(spec.experiment->step);
   } else {
     throw model::CaseFileError(spec.source, 1, "experiment.step",

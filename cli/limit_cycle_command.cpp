@@ -24,7 +24,8 @@ struct LimitCycleOptions {
 void run_limit_cycle(const LimitCycleOptions& options) {
   const ValidatedCase c = validated_case(options.case_name);
   numeric::EffectLimitCycleOptions lc;
-  if (c.spec.experiment) lc.step = model::to_double(c.spec.experiment->step);
+  if (c.spec.experiment && c.spec.experiment->kind == model::ExperimentKind::Step)
+    lc.step = model::to_double(c.spec.experiment->step);
   const numeric::LimitCycle cycle = numeric::find_limit_cycle(c.model(), lc);
   const bool found = cycle.status == "limit_cycle";
   const bool with_effects = c.model().effects().any();

@@ -36,6 +36,9 @@ void run_simulate(const SimulateOptions& options) {
   const ValidatedCase c = validated_case(options.case_name);
   if (!step) {
     if (!c.spec.experiment) throw UsageError("--step is required (the case file has no [experiment] step)");
+    if (c.spec.experiment->kind != model::ExperimentKind::Step)
+      throw UsageError("--step is required (the case file's experiment is a measured drive, which needs its record: "
+                       "use `backlash discrepancy`)");
     step = model::to_double(c.spec.experiment->step);
   }
   if (!t_end) t_end = c.spec.experiment && c.spec.experiment->t_end ? model::to_double(*c.spec.experiment->t_end) : 60.0;

@@ -253,18 +253,24 @@ class CaseFileReader {
     spec.id = file_.stem().string();
 
     reject_unknown_keys(root, "",
-                        {"name", "measured_at", "K", "backlash", "reference", "motor", "load", "experiment", "effects"});
+                        {"name", "measured_at", "K", "backlash", "reference", "motor", "load", "experiment", "effects", "fit"});
     const long top_line = 1;
     spec.name = read_name(require(root, "", top_line, "name"));
     spec.measured_at = read_measured_at(require(root, "", top_line, "measured_at"));
+    if (const toml::node* experiment_node = root.get("experiment")) spec.experiment = read_experiment(*experiment_node, top_line);
+    const bool open_loop = spec.experiment && spec.experiment->kind == ExperimentKind::Drive;
 
-    const toml::node& gain_node = require(root, "", top_line, "K");
-    const ExactNumber gain = read_number(gain_node, "K");
-    if (gain.value <= 0)
-      fail(line_of(gain_node, top_line), "K",
-           "non-positive loop gain (got " + gain.as_written +
-               "; K must be > 0, otherwise the loop does not pull the output toward the reference)");
-    spec.K = gain.value;
+    if (open_loop && !root.get("K")) {
+      spec.K = 1;  // a measured drive opens the loop: K is not used
+    } else {
+      const toml::node& gain_node = require(root, "", top_line, "K");
+      const ExactNumber gain = read_number(gain_node, "K");
+      if (gain.value <= 0)
+        fail(line_of(gain_node, top_line), "K",
+             "non-positive loop gain (got " + gain.as_written +
+                 "; K must be > 0, otherwise the loop does not pull the output toward the reference)");
+      spec.K = gain.value;
+    }
 
     const toml::node& backlash_node = require(root, "", top_line, "backlash");
     const ExactNumber backlash = read_number(backlash_node, "backlash");
@@ -278,23 +284,77 @@ class CaseFileReader {
     read_body(root, "motor", spec.Jm, spec.Fm);
     read_body(root, "load", spec.JL, spec.FL);
 
-    if (const toml::node* experiment_node = root.get("experiment")) {
-      const toml::table& experiment = require_table(*experiment_node, "experiment");
-      const long header_line = line_of(experiment, top_line);
-      reject_unknown_keys(experiment, "experiment", {"step", "t_end"});
-      Experiment parsed;
-      parsed.step = read_number(require(experiment, "experiment", header_line, "step"), "experiment.step").value;
-      if (const toml::node* end_node = experiment.get("t_end")) {
-        const ExactNumber end_time = read_number(*end_node, "experiment.t_end");
-        if (end_time.value <= 0)
-          fail(line_of(*end_node, header_line), "experiment.t_end",
-               "non-positive end time (got " + end_time.as_written + "; t_end must be > 0)");
-        parsed.t_end = end_time.value;
-      }
-      spec.experiment = parsed;
-    }
     if (const toml::node* effects_node = root.get("effects")) spec.effects = read_effects(*effects_node, top_line);
+    if (const toml::node* fit_node = root.get("fit")) spec.fit_free = read_fit(*fit_node, top_line);
     return spec;
+  }
+
+  /// [experiment]: kind = "step" (default: step required) or "drive" (drive_gain optional).
+  Experiment read_experiment(const toml::node& node, long fallback_line) const {
+    const toml::table& experiment = require_table(node, "experiment");
+    const long header_line = line_of(experiment, fallback_line);
+    reject_unknown_keys(experiment, "experiment", {"kind", "step", "t_end", "drive_gain"});
+    Experiment parsed;
+    if (const toml::node* kind_node = experiment.get("kind")) {
+      const auto* text = kind_node->as_string();
+      if (text == nullptr || (text->get() != "step" && text->get() != "drive"))
+        fail(line_of(*kind_node, header_line), "experiment.kind",
+             std::string("expected \"step\" or \"drive\", got ") +
+                 (text ? "\"" + text->get() + "\"" : std::string(describe_node_type(*kind_node))));
+      parsed.kind = text->get() == "drive" ? ExperimentKind::Drive : ExperimentKind::Step;
+    }
+    if (parsed.kind == ExperimentKind::Step) {
+      if (const toml::node* gain_node = experiment.get("drive_gain"))
+        fail(line_of(*gain_node, header_line), "experiment.drive_gain",
+             "only a measured-drive experiment (kind = \"drive\") has a drive gain");
+      parsed.step = read_number(require(experiment, "experiment", header_line, "step"), "experiment.step").value;
+    } else {
+      if (const toml::node* step_node = experiment.get("step"))
+        fail(line_of(*step_node, header_line), "experiment.step",
+             "a measured-drive experiment has no step: the drive comes from the record's drive column");
+      if (const toml::node* gain_node = experiment.get("drive_gain")) {
+        const ExactNumber gain = read_number(*gain_node, "experiment.drive_gain");
+        if (gain.value == 0)
+          fail(line_of(*gain_node, header_line), "experiment.drive_gain", "zero drive gain (got " + gain.as_written + ")");
+        parsed.drive_gain = gain.value;
+      }
+    }
+    if (const toml::node* end_node = experiment.get("t_end")) {
+      const ExactNumber end_time = read_number(*end_node, "experiment.t_end");
+      if (end_time.value <= 0)
+        fail(line_of(*end_node, header_line), "experiment.t_end",
+             "non-positive end time (got " + end_time.as_written + "; t_end must be > 0)");
+      parsed.t_end = end_time.value;
+    }
+    return parsed;
+  }
+
+  /// [fit]: free = ["motor.J", ...] — known names, no repeats.
+  std::vector<std::string> read_fit(const toml::node& node, long fallback_line) const {
+    const toml::table& fit = require_table(node, "fit");
+    const long header_line = line_of(fit, fallback_line);
+    reject_unknown_keys(fit, "fit", {"free"});
+    const toml::node& free_node = require(fit, "fit", header_line, "free");
+    const toml::array* names = free_node.as_array();
+    if (names == nullptr)
+      fail(line_of(free_node, header_line), "fit.free",
+           std::string("expected an array of parameter names, got ") + describe_node_type(free_node));
+    std::vector<std::string> out;
+    for (const toml::node& entry : *names) {
+      const auto* text = entry.as_string();
+      const auto& known = fittable_parameters();
+      if (text == nullptr || std::find(known.begin(), known.end(), text->get()) == known.end()) {
+        std::string allowed;
+        for (const std::string& k : known) allowed += (allowed.empty() ? "" : ", ") + k;
+        fail(line_of(entry, line_of(free_node, header_line)), "fit.free",
+             "unknown parameter " + (text ? "\"" + text->get() + "\"" : std::string(describe_node_type(entry))) +
+                 " (allowed: " + allowed + ")");
+      }
+      if (std::find(out.begin(), out.end(), text->get()) != out.end())
+        fail(line_of(entry, line_of(free_node, header_line)), "fit.free", "\"" + text->get() + "\" given twice");
+      out.push_back(text->get());
+    }
+    return out;
   }
 
  private:
@@ -485,12 +545,21 @@ class CaseFileReader {
   SourceLines lines_;
 };
 
+/// Largest case file read: a case file is a few hundred bytes.
+constexpr std::uintmax_t largest_case_file = 1 << 20;
+
 std::string read_whole_file(const std::filesystem::path& file) {
   std::error_code status;
-  if (!std::filesystem::exists(file, status))
-    throw CaseFileError(file, 0, "", "cannot open case file: no such file");
-  if (std::filesystem::is_directory(file, status))
-    throw CaseFileError(file, 0, "", "cannot open case file: it is a directory");
+  const std::filesystem::file_status kind = std::filesystem::status(file, status);
+  if (status && status != std::errc::no_such_file_or_directory)
+    throw CaseFileError(file, 0, "", "cannot open case file: " + status.message());
+  if (!std::filesystem::exists(kind)) throw CaseFileError(file, 0, "", "cannot open case file: no such file");
+  if (std::filesystem::is_directory(kind)) throw CaseFileError(file, 0, "", "cannot open case file: it is a directory");
+  if (!std::filesystem::is_regular_file(kind))
+    throw CaseFileError(file, 0, "", "cannot open case file: not a regular file (a device, a pipe or a socket)");
+  const std::uintmax_t size = std::filesystem::file_size(file, status);
+  if (!status && size > largest_case_file)
+    throw CaseFileError(file, 0, "", "case file too large (" + std::to_string(size) + " bytes; a case file is at most 1 MiB)");
   std::ifstream stream(file, std::ios::binary);
   if (!stream) throw CaseFileError(file, 0, "", std::string("cannot open case file: ") + std::strerror(errno));
   std::ostringstream contents;
@@ -524,6 +593,11 @@ CaseSpec load_case_file(const std::filesystem::path& file) {
     throw CaseFileError(file, line > 0 ? line : 1, "syntax", std::string(error.description()));
   }
   return CaseFileReader(file, contents).read(root);
+}
+
+const std::vector<std::string>& fittable_parameters() {
+  static const std::vector<std::string> names{"motor.J", "motor.F", "load.J", "load.F", "K", "backlash", "reference"};
+  return names;
 }
 
 const std::vector<std::string>& thesis_case_ids() {

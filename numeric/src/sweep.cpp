@@ -33,7 +33,7 @@ std::vector<SweepPoint> figure31_points(int n) {
       p.JL = jl_over_jm / (1 + jl_over_jm);
       p.FL = x * F;
       p.Fm = F - p.FL;
-      points.push_back({series, x, p});
+      points.push_back({series, x, p, {}});
     }
   }
   return points;
@@ -51,7 +51,7 @@ std::vector<SweepPoint> figure32_points(int n) {
       p.JL = x / (1 + x);
       p.Fm = d.Fm;
       p.FL = d.FL;
-      points.push_back({d.name, x, p});
+      points.push_back({d.name, x, p, {}});
     }
   }
   return points;

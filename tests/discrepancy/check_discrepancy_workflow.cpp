@@ -54,7 +54,7 @@ model::CaseSpec spec_of(const std::string& name, const Parameters& p, double ste
   s.Fm = exact(p.Fm);
   s.JL = exact(p.JL);
   s.FL = exact(p.FL);
-  s.experiment = model::Experiment{exact(step), std::nullopt};
+  s.experiment = model::Experiment{model::ExperimentKind::Step, exact(step), model::Rational(1), std::nullopt};
   return s;
 }
 

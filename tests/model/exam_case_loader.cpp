@@ -303,19 +303,83 @@ TEST_F(CaseFileVariants, RestitutionWithComplianceIsRefused) {
                   "damping); give one of them");
 }
 
+// ------------------------------------------------------------------ measured-drive experiments and [fit]
+
+std::vector<std::string> drive_model(const std::vector<std::string>& experiment, const std::vector<std::string>& rest = {}) {
+  std::vector<std::string> lines{"name = \"Drive\"", "measured_at = \"motor\"", "backlash = 0", "reference = 0",
+                                 "[motor]", "J = 95", "F = 200", "[load]", "J = 1e-6", "F = 0", "[experiment]"};  // 1..11
+  lines.insert(lines.end(), experiment.begin(), experiment.end());
+  lines.insert(lines.end(), rest.begin(), rest.end());
+  return lines;
+}
+
+TEST_F(CaseFileVariants, AMeasuredDriveExperimentOpensTheLoop) {
+  const CaseSpec spec = load(drive_model({"kind = \"drive\"", "drive_gain = 35.15", "t_end = 24.8"}));
+  ASSERT_TRUE(spec.experiment.has_value());
+  EXPECT_EQ(spec.experiment->kind, backlash::model::ExperimentKind::Drive);
+  expect_exact(spec.experiment->drive_gain, exact(703, 20), "experiment.drive_gain");
+  expect_exact(spec.K, exact(1), "K (absent: unused)");
+  expect_exact(spec.backlash, exact(0), "backlash");  // a rigid drive is a valid model
+  const CaseSpec default_gain = load(drive_model({"kind = \"drive\""}));
+  expect_exact(default_gain.experiment->drive_gain, exact(1), "experiment.drive_gain (default)");
+}
+
+TEST_F(CaseFileVariants, BadExperimentKindsNameLineAndKey) {
+  expect_rejected(drive_model({"kind = \"ramp\""}), 12, "experiment.kind", "expected \"step\" or \"drive\", got \"ramp\"");
+  expect_rejected(drive_model({"kind = \"drive\"", "step = 1"}), 13, "experiment.step",
+                  "a measured-drive experiment has no step: the drive comes from the record's drive column");
+  expect_rejected(drive_model({"step = 1", "drive_gain = 2"}), 13, "experiment.drive_gain",
+                  "only a measured-drive experiment (kind = \"drive\") has a drive gain");
+  expect_rejected(drive_model({"kind = \"drive\"", "drive_gain = 0"}), 13, "experiment.drive_gain", "zero drive gain (got 0)");
+  expect_rejected(drive_model({"step = 1"}), 1, "K", "missing key");  // a step experiment closes the loop: K is needed
+}
+
+TEST_F(CaseFileVariants, FitNamesTheFreeNominalParameters) {
+  const CaseSpec spec = load(drive_model({"kind = \"drive\""}, {"[fit]", "free = [\"motor.J\", \"motor.F\"]"}));
+  ASSERT_EQ(spec.fit_free.size(), 2u);
+  EXPECT_EQ(spec.fit_free[0], "motor.J");
+  EXPECT_EQ(spec.fit_free[1], "motor.F");
+  expect_rejected(drive_model({"kind = \"drive\""}, {"[fit]", "free = [\"motor.M\"]"}), 14, "fit.free",
+                  "unknown parameter \"motor.M\" (allowed: motor.J, motor.F, load.J, load.F, K, backlash, reference)");
+  expect_rejected(drive_model({"kind = \"drive\""}, {"[fit]", "free = [\"K\", \"K\"]"}), 14, "fit.free",
+                  "\"K\" given twice");
+  expect_rejected(drive_model({"kind = \"drive\""}, {"[fit]", "free = \"motor.J\""}), 14, "fit.free",
+                  "expected an array of parameter names, got a string");
+  expect_rejected(drive_model({"kind = \"drive\""}, {"[fit]", "fixed = []"}), 14, "fit.fixed",
+                  "unknown key (allowed: free)");
+}
+
+TEST_F(CaseFileVariants, OnlyASmallRegularFileIsRead) {
+  for (const char* special : {"/dev/zero", "/dev/null"}) {
+    try {
+      load_case_file(special);
+      ADD_FAILURE() << special << " was read";
+    } catch (const CaseFileError& error) {
+      EXPECT_NE(std::string(error.what()).find("not a regular file"), std::string::npos) << error.what();
+    }
+  }
+  const std::filesystem::path big = write({std::string(2 << 20, '#')}, "big.toml");
+  try {
+    load_case_file(big);
+    ADD_FAILURE() << "a 2 MiB file was read";
+  } catch (const CaseFileError& error) {
+    EXPECT_NE(std::string(error.what()).find("case file too large"), std::string::npos) << error.what();
+  }
+}
+
 TEST_F(CaseFileVariants, UnknownKeyInATable) {
   expect_rejected(with_inserted_line(10, "G = 2"), 10, "motor.G", "unknown key (allowed: J, F)");
 }
 
 TEST_F(CaseFileVariants, UnknownTopLevelKey) {
   expect_rejected(with_inserted_line(4, "gain = 2"), 4, "gain",
-                  "unknown key (allowed: name, measured_at, K, backlash, reference, motor, load, experiment, effects)");
+                  "unknown key (allowed: name, measured_at, K, backlash, reference, motor, load, experiment, effects, fit)");
 }
 
 TEST_F(CaseFileVariants, UnknownKeyDifferingOnlyInCaseGetsAHint) {
   expect_rejected(with_line(3, "k = 1"), 3, "k",
                   "unknown key (did you mean 'K'? allowed: name, measured_at, K, backlash, reference, motor, load, "
-                  "experiment, effects)");
+                  "experiment, effects, fit)");
 }
 
 TEST_F(CaseFileVariants, UnknownTable) {
@@ -323,7 +387,7 @@ TEST_F(CaseFileVariants, UnknownTable) {
   lines.push_back("[gearbox]");
   lines.push_back("ratio = 2");
   expect_rejected(lines, 18, "gearbox",
-                  "unknown key (allowed: name, measured_at, K, backlash, reference, motor, load, experiment, effects)");
+                  "unknown key (allowed: name, measured_at, K, backlash, reference, motor, load, experiment, effects, fit)");
 }
 
 TEST_F(CaseFileVariants, MissingKeyInATableNamesTheTableHeaderLine) {

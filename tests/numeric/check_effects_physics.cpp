@@ -125,7 +125,7 @@ TEST(EffectsGate, EveryModeOfEveryEffectPassesOnTheThesisCases) {
   each[4].torque_offset = -0.02;
   each[5] = coulomb(0.02, 0);
   each[5].saturation = 0.2;
-  for (const std::string& id : {"I", "II", "V", "VIII"})
+  for (const char* id : {"I", "II", "V", "VIII"})
     for (const Effects& e : each) {
       const numeric::EffectValidationResult r = numeric::validate_effects(nominal(id), e);
       EXPECT_TRUE(r.passed()) << id << " " << e.describe() << "\n" << r.report().summary();
@@ -196,7 +196,7 @@ TEST(EffectsCoulomb, AStuckMotorStaysPutInsideTheBandAndBreaksAwayAtItsEdge) {
 }
 
 TEST(EffectsCoulomb, LargeFrictionStopsTheServoInADeadBandAwayFromTheReference) {
-  for (const std::string& id : {"V", "III", "I"}) {
+  for (const char* id : {"V", "III", "I"}) {
     const Effects e = coulomb(0.08, 0.06);
     const auto& model = with_effects(nominal(id), e);
     const Parameters& p = model.parameters();
@@ -240,7 +240,7 @@ TEST(EffectsEnergy, WithTheOutputAtTheMotorTheEnergyNeverGrows) {
   each[3].mesh_damping = 4;
   each[4].torque_offset = 0.05;
   each[4].coulomb_load = 0.01;
-  for (const std::string& id : {"I", "II"})
+  for (const char* id : {"I", "II"})
     for (const Effects& e : each) {
       const auto& model = with_effects(nominal(id), e);
       const Parameters& p = model.parameters();
@@ -333,7 +333,7 @@ TEST(EffectsCompliance, TheMeshPushesAndNeverPulls) {
   Effects e;
   e.mesh_stiffness = 400;
   e.mesh_damping = 4;
-  for (const std::string& id : {"V", "I", "VIII"}) {
+  for (const char* id : {"V", "I", "VIII"}) {
     const auto& model = with_effects(nominal(id), e);
     const Parameters& p = model.parameters();
     const SimulationResult r = numeric::simulate_effects_step(model, step_of(id), sampled(40, 0.001));
@@ -479,7 +479,7 @@ TEST(EffectsPairs, EveryPairRunsToAStatusOnCaseV) {
 // ------------------------------------------------------------------ limit cycles with effects
 
 TEST(EffectsLimitCycle, TheGeneralReturnMapReproducesEveryNominalCycle) {
-  for (const std::string& id : {"III", "IV", "V", "VI", "VII", "VIII"}) {
+  for (const char* id : {"III", "IV", "V", "VI", "VII", "VIII"}) {
     const numeric::LimitCycle n = numeric::find_limit_cycle(nominal(id));
     numeric::EffectLimitCycleOptions o;
     o.general = true;

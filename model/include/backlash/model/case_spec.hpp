@@ -26,9 +26,16 @@ using Rational = boost::multiprecision::cpp_rational;
 
 enum class MeasuredAt { Motor, Load };
 
-/// An optional step experiment: start at rest in contact with θo = θR − step.
+enum class ExperimentKind {
+  Step,   ///< start at rest in contact with θo = θR − step; the loop K(θR − θo) drives
+  Drive,  ///< a measured drive: the drive torque is a record's `drive` column × drive_gain, the loop is open
+};
+
+/// An optional experiment ([experiment]).
 struct Experiment {
-  Rational step;
+  ExperimentKind kind = ExperimentKind::Step;
+  Rational step;                 ///< step experiments (0 for a measured drive)
+  Rational drive_gain{1};        ///< measured drive: torque per unit of the `drive` column
   std::optional<Rational> t_end;
 };
 
@@ -70,7 +77,13 @@ struct CaseSpec {
   Rational JL, FL;           ///< load inertia and viscous friction
   std::optional<Experiment> experiment;
   Effects effects;           ///< the [effects] table (all neutral when absent)
+  /// [fit] free = [...]: the nominal parameters a record may correct ("motor.J", "motor.F",
+  /// "load.J", "load.F", "K", "backlash", "reference"), fitted before any effect is sought.
+  std::vector<std::string> fit_free;
 };
+
+/// The names [fit] free accepts, in this order.
+const std::vector<std::string>& fittable_parameters();
 
 /// A bad case file. what() is one line: "FILE:LINE: KEY: problem".
 class CaseFileError : public std::runtime_error {
@@ -88,6 +101,9 @@ class CaseFileError : public std::runtime_error {
 
 /// Strict loader: unknown or missing keys, non-positive inertia, negative
 /// friction/backlash/gain, non-finite or non-numeric values → CaseFileError.
+/// The file must be a regular file of at most 1 MiB (a case file is a few hundred bytes:
+/// /dev/zero or a log is refused before it is read).  K may be omitted only with a
+/// measured-drive experiment (the loop is open: it is then 1 and unused).
 /// [effects]: negative Coulomb torque, e outside [0, 1), a limit <= 0, a
 /// stiffness <= 0, a negative damping or delay, an unknown effect, and the pair
 /// restitution + compliance (both would model the impact) → CaseFileError.
