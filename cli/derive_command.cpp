@@ -5,6 +5,7 @@
 
 #include "backlash/model/case_spec.hpp"
 #include "backlash/symbolic/derivation_output.hpp"
+#include "backlash/symbolic/forced_modes.hpp"
 #include "backlash/symbolic/general_derivation.hpp"
 
 #include <iostream>
@@ -34,10 +35,14 @@ void run_derive(const DeriveOptions& options) {
   }
   const model::CaseSpec spec = model::load_case(options.case_name);
   const symbolic::CaseDerivation derivation = symbolic::derive_case(spec);
-  if (options.json)
-    std::cout << symbolic::to_json(derivation).dump(2) << "\n";
-  else if (options.latex)
-    std::cout << symbolic::to_latex(derivation);
+  if (options.json) {
+    nlohmann::json document = symbolic::to_json(derivation);
+    // The modes the effects add (constant torques, the closed motor loop, coupled free flight).
+    document["forced_modes"] = symbolic::forced_modes_json(symbolic::derive_forced_modes(derivation));
+    std::cout << document.dump(2) << "\n";
+  } else if (options.latex) {
+    std::cout << symbolic::to_latex(derivation) << symbolic::forced_modes_latex(symbolic::derive_forced_modes(derivation));
+  }
   else
     std::cout << symbolic::to_text(derivation);
 }

@@ -1,4 +1,5 @@
 #include "backlash/codegen/emit.hpp"
+#include "backlash/codegen/emit_forced.hpp"
 
 #include "backlash/symbolic/escape.hpp"
 
@@ -576,6 +577,7 @@ std::string CaseEmitter::header(const model::CaseSpec& spec) {
   for (const auto& [name, tex] : latex())
     h << "  static constexpr const char* " << name << " = R\"tex(" << tex << ")tex\";\n";
   h << "};\n\n";
+  h << emit_forced_namespace(d_);  // namespace forced: the modes with a constant forcing (emit_forced.hpp)
   h << "}  // namespace backlash::generated::" << ns << "\n";
   return h.str();
 }
@@ -873,6 +875,7 @@ std::string emit_case_latex(const model::CaseSpec& spec, const symbolic::CaseDer
   for (const auto& [key, lhs] : rows)
     out << "\\begin{equation}\\label{eq:gen:" << d.case_id << ":" << key << "}\n"
         << lhs << " = " << tex.at(key) << "\n\\end{equation}\n";
+  out << emit_forced_latex(d);  // the forced modes' section (emit_forced.hpp)
   return out.str();
 }
 
