@@ -47,6 +47,18 @@ double evaluate_to_double(const ex& expression) {
 
 ex expanded(const ex& expression) { return expression.expand(expand_options::expand_function_args); }
 
+std::string join_terms(const std::vector<std::string>& terms) {
+  if (terms.empty()) return "0";
+  std::string out;
+  for (std::size_t i = 0; i < terms.size(); ++i) {
+    const std::string& t = terms[i];
+    if (i == 0) out = t;
+    else if (t.rfind("-", 0) == 0) out += std::string(" - ") + t.substr(1);
+    else out += std::string(" + ") + t;
+  }
+  return out;
+}
+
 namespace {
 
 std::string integer_text(const numeric& integer) {
@@ -65,21 +77,14 @@ std::string join(std::vector<std::string> parts, const std::string& separator, b
   return out;
 }
 
-// Sum text with "+ -x" written "- x".
+// Sum text (operands sorted) with "+ -x" written "- x"; an add has at least two operands.
 std::string join_sum(std::vector<std::string> parts) {
   std::sort(parts.begin(), parts.end(), [](const std::string& a, const std::string& b) {
     // order by the text without a leading sign, so x and -x sort together
     const std::string ka = a.rfind("-", 0) == 0 ? a.substr(1) : a, kb = b.rfind("-", 0) == 0 ? b.substr(1) : b;
     return ka != kb ? ka < kb : a < b;
   });
-  std::string out;
-  for (std::size_t i = 0; i < parts.size(); ++i) {
-    const std::string& p = parts[i];
-    if (i == 0) out = p;
-    else if (p.rfind("-", 0) == 0) out += std::string(" - ") + p.substr(1);
-    else out += std::string(" + ") + p;
-  }
-  return out;
+  return join_terms(parts);
 }
 
 std::string number(const numeric& value, Style style) {

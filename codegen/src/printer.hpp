@@ -13,6 +13,7 @@
 #include <ginac/ginac.h>
 
 #include <string>
+#include <vector>
 
 namespace backlash::codegen::detail {
 
@@ -29,6 +30,9 @@ struct Fraction {
 };
 Fraction canonical_fraction(const GiNaC::ex& expression);
 std::string print(const Fraction& fraction, Style style);
+
+/// Sum of already printed terms, "+ -x" written "- x" (order kept); "0" if none.
+std::string join_terms(const std::vector<std::string>& terms);
 
 /// Shortest text that reads back as exactly `value` (≤ 17 significant digits),
 /// always a floating literal ("2.0", "0.20000000000000001", "1e-20").
