@@ -1,0 +1,375 @@
+// The measured-drive workflow's results as files: JSON, a Markdown page with its figures
+// (deterministic SVG), and the corrected case file.  No timings in the files: the same
+// record gives the same bytes.
+#include "backlash/discrepancy/measured_drive.hpp"
+
+#include "plots.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+namespace backlash::discrepancy {
+
+namespace {
+
+using detail::Band;
+using detail::Series;
+using detail::bar_chart;
+using detail::line_plot;
+using detail::number;
+
+nlohmann::json json_number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json values_json(const std::vector<Parameter>& ps) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const Parameter& p : ps) out[p.name] = json_number(p.value);
+  return out;
+}
+
+nlohmann::json sigmas_json(const std::vector<Parameter>& ps) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const Parameter& p : ps) out[p.name] = json_number(p.uncertainty);
+  return out;
+}
+
+nlohmann::json candidate_json(const Candidate& c) {
+  return {{"effect", c.effect},
+          {"parameters", values_json(c.parameters)},
+          {"rms", json_number(c.rms)},
+          {"rms_fit", json_number(c.rms_fit)},
+          {"rms_holdout", json_number(c.rms_holdout)},
+          {"bic", json_number(c.bic)},
+          {"delta_bic", json_number(c.delta_bic)},
+          {"score", json_number(c.delta_bic)},
+          {"decisive", c.decisive},
+          {"at_range_edge", c.at_range_edge},
+          {"least_squares", c.simulations},
+          {"failure", c.failure}};
+}
+
+nlohmann::json region_json(const TorqueRegion& g) {
+  nlohmann::json out{{"kind", g.kind},         {"samples", g.samples},         {"rms", g.rms_before},
+                     {"rms_after", g.rms_after}, {"mean", g.mean_before},       {"mean_after", g.mean_after}};
+  if (std::isfinite(g.t_start)) out["t_start"] = g.t_start, out["t_end"] = g.t_end;
+  return out;
+}
+
+nlohmann::json scores_json(const DriveScores& s) {
+  return {{"record", s.record},
+          {"samples", s.samples},
+          {"torque_rms_nominal", s.torque_rms_nominal},
+          {"torque_rms_corrected", s.torque_rms_corrected},
+          {"position_rms_nominal", s.position_rms_nominal},
+          {"position_rms_corrected", s.position_rms_corrected},
+          {"windows", s.windows}};
+}
+
+nlohmann::json parameters_json(const numeric::Parameters& p) {
+  return {{"motor.J", p.Jm}, {"motor.F", p.Fm}, {"load.J", p.JL}, {"load.F", p.FL}};
+}
+
+// The shortest decimal that reads back as the same double (the loader reads decimals exactly).
+std::string decimal(double value) {
+  char buffer[64];
+  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  std::string text(buffer, error == std::errc() ? end : buffer);
+  if (text.find_first_of(".e") == std::string::npos) text += ".0";
+  return text;
+}
+
+std::string quoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) continue;
+    out += c;
+  }
+  return out + "\"";
+}
+
+std::string exact_or(const model::Rational& original, double value) {
+  return model::to_double(original) == value ? quoted(model::to_string(original)) : decimal(value);
+}
+
+// The stretch of `count` windows that starts at the window with the largest error of `model`.
+std::pair<std::size_t, std::size_t> worst_windows(const std::vector<double>& t, const std::vector<double>& measured,
+                                                  const std::vector<double>& model, const std::vector<double>& starts,
+                                                  int count) {
+  if (starts.empty() || t.empty()) return {0, t.size()};
+  std::size_t worst = 0;
+  double worst_error = -1;
+  std::size_t k = 0;
+  for (std::size_t w = 0; w < starts.size(); ++w) {
+    const double end = w + 1 < starts.size() ? starts[w + 1] : INFINITY;
+    double e = 0;
+    for (; k < t.size() && t[k] < end; ++k)
+      if (std::isfinite(model[k])) e = std::max(e, std::fabs(measured[k] - model[k]));
+    if (e > worst_error) worst_error = e, worst = w;
+  }
+  const std::size_t first_window = worst >= static_cast<std::size_t>(count / 2) ? worst - count / 2 : 0;
+  const double from = starts[first_window];
+  const double to = first_window + count < starts.size() ? starts[first_window + count] : INFINITY;
+  const std::size_t a = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), from) - t.begin());
+  const std::size_t b = static_cast<std::size_t>(std::lower_bound(t.begin(), t.end(), to) - t.begin());
+  return {a, std::min(b + 1, t.size())};
+}
+
+std::vector<double> slice(const std::vector<double>& v, std::pair<std::size_t, std::size_t> range) {
+  return std::vector<double>(v.begin() + static_cast<std::ptrdiff_t>(range.first),
+                             v.begin() + static_cast<std::ptrdiff_t>(range.second));
+}
+
+// The mean of y in equal bins of x (NaN in an empty bin).
+std::pair<std::vector<double>, std::vector<double>> binned_mean(const std::vector<double>& x, const std::vector<double>& y,
+                                                                int bins) {
+  double lo = INFINITY, hi = -INFINITY;
+  for (double v : x) lo = std::min(lo, v), hi = std::max(hi, v);
+  std::vector<double> centre(bins), sum(bins, 0.0), count(bins, 0.0);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const int b = std::min(bins - 1, static_cast<int>((x[i] - lo) / (hi - lo) * bins));
+    sum[b] += y[i];
+    count[b] += 1;
+  }
+  for (int b = 0; b < bins; ++b) {
+    centre[b] = lo + (b + 0.5) * (hi - lo) / bins;
+    sum[b] = count[b] > 0 ? sum[b] / count[b] : NAN;
+  }
+  return {centre, sum};
+}
+
+}  // namespace
+
+std::string drive_to_json(const model::CaseSpec& model, const DriveDiscrepancyResult& r) {
+  nlohmann::json candidates = nlohmann::json::array(), rounds = nlohmann::json::array();
+  for (std::size_t k = 0; k < r.rounds.size(); ++k) {
+    nlohmann::json round = nlohmann::json::array();
+    for (const Candidate& c : r.rounds[k]) {
+      round.push_back(candidate_json(c));
+      if (k == 0) candidates.push_back(candidate_json(c));
+    }
+    rounds.push_back(round);
+  }
+  nlohmann::json effects = nlohmann::json::array();
+  for (const Candidate& c : r.effects)
+    effects.push_back({{"effect", c.effect},
+                       {"parameters", values_json(c.parameters)},
+                       {"uncertainty", sigmas_json(c.parameters)},
+                       {"delta_bic", json_number(c.delta_bic)}});
+  nlohmann::json regions = nlohmann::json::array(), classes = nlohmann::json::array();
+  for (const TorqueRegion& g : r.stretches) regions.push_back(region_json(g));
+  for (const TorqueRegion& g : r.classes) classes.push_back(region_json(g));
+  nlohmann::json fitted = nlohmann::json::array(), refitted = nlohmann::json::array();
+  for (const Parameter& p : r.nominal_fit) fitted.push_back({{"name", p.name}, {"value", p.value}, {"uncertainty", json_number(p.uncertainty)}});
+  for (const Parameter& p : r.corrected_nominal)
+    refitted.push_back({{"name", p.name}, {"value", p.value}, {"uncertainty", json_number(p.uncertainty)}});
+  const bool found = !r.effects.empty();
+  nlohmann::json out{
+      {"model", model.source.string()},
+      {"experiment", "drive"},
+      {"status", to_string(r.status)},
+      {"effect", found ? nlohmann::json(r.effects.front().effect) : nlohmann::json(nullptr)},
+      {"parameters", found ? values_json(r.effects.front().parameters) : nlohmann::json(nullptr)},
+      {"effects", effects},
+      {"rms_before", r.rms_before},
+      {"rms_after", r.rms_after},
+      {"rms_unit", "torque (inverse dynamics)"},
+      {"rms_given", r.rms_given},
+      {"noise", r.noise},
+      {"noise_sources", {{"position", r.position_noise}, {"drive", r.drive_noise}}},
+      {"band",
+       {{"sample_rate", r.sample_rate},
+        {"cutoff", r.cutoff},
+        {"cutoff_from_spectrum", r.cutoff_from_spectrum},
+        {"spectrum_floor", json_number(r.spectrum_floor)},
+        {"rest_speed", r.rest_speed}}},
+      {"tau_int", {{"before", r.tau_int_before}, {"after", r.tau_int_after}}},
+      {"nominal", {{"given", parameters_json(r.given)}, {"fitted", fitted}, {"parameters", parameters_json(r.nominal)}}},
+      {"corrected", {{"parameters", parameters_json(r.parameters)}, {"refitted", refitted}, {"effects", r.corrected_effects.describe()}}},
+      {"candidates", candidates},
+      {"rounds", rounds},
+      {"regions", regions},
+      {"classes", classes},
+      {"estimation", scores_json(r.estimation)},
+      {"validation", r.validation ? scores_json(*r.validation) : nlohmann::json(nullptr)},
+      {"least_squares", r.least_squares}};
+  return out.dump(2) + "\n";
+}
+
+std::string drive_corrected_case_file(const model::CaseSpec& spec, const DriveDiscrepancyResult& r) {
+  std::ostringstream out;
+  out << "# The model of " << spec.source.filename().string() << " corrected by `backlash discrepancy` (measured drive).\n";
+  for (const Parameter& p : r.corrected_nominal) out << "#   " << p.name << " = " << p.value << " ± " << p.uncertainty << "\n";
+  for (const Candidate& c : r.effects)
+    for (const Parameter& p : c.parameters) out << "#   " << c.effect << ": " << p.name << " = " << p.value << " ± " << p.uncertainty << "\n";
+  out << "# Torque RMS of the inverse dynamics: " << r.rms_before << " (best nominal model) -> " << r.rms_after << ".\n";
+  const numeric::Parameters& p = r.parameters;
+  const numeric::Effects& e = r.corrected_effects;
+  out << "name = " << quoted(spec.name + " (corrected)") << "\n";
+  out << "measured_at = \"" << model::to_string(spec.measured_at) << "\"\n";
+  out << "K = " << quoted(model::to_string(spec.K)) << "\n";
+  out << "backlash = 0\n";
+  out << "reference = " << quoted(model::to_string(spec.reference)) << "\n\n";
+  out << "[motor]\nJ = " << exact_or(spec.Jm, p.Jm) << "\nF = " << exact_or(spec.Fm, p.Fm) << "\n\n";
+  out << "[load]\nJ = " << exact_or(spec.JL, p.JL) << "\nF = " << exact_or(spec.FL, p.FL) << "\n\n";
+  out << "[experiment]\nkind = \"drive\"\ndrive_gain = " << quoted(model::to_string(spec.experiment->drive_gain)) << "\n";
+  if (spec.experiment->t_end) out << "t_end = " << quoted(model::to_string(*spec.experiment->t_end)) << "\n";
+  if (!spec.fit_free.empty()) {
+    out << "\n[fit]\nfree = [";
+    for (std::size_t i = 0; i < spec.fit_free.size(); ++i) out << (i ? ", " : "") << quoted(spec.fit_free[i]);
+    out << "]\n";
+  }
+  if (!e.any()) return out.str();
+  const model::Effects& m = spec.effects;
+  out << "\n[effects]\n";
+  if (e.coulomb_motor > 0) out << "coulomb_motor = " << exact_or(m.coulomb_motor, e.coulomb_motor) << "\n";
+  if (e.coulomb_load > 0) out << "coulomb_load = " << exact_or(m.coulomb_load, e.coulomb_load) << "\n";
+  if (e.saturating()) out << "saturation = " << (m.saturation ? exact_or(*m.saturation, e.saturation) : decimal(e.saturation)) << "\n";
+  if (e.delayed()) out << "delay = " << exact_or(m.delay, e.delay) << "\n";
+  if (e.torque_offset != 0) out << "torque_offset = " << exact_or(m.torque_offset, e.torque_offset) << "\n";
+  return out.str();
+}
+
+std::vector<std::pair<std::string, std::string>> drive_report_files(const model::CaseSpec& model, const std::string& data_name,
+                                                                    const std::string& validation_name,
+                                                                    const DriveDiscrepancyResult& r) {
+  std::vector<std::pair<std::string, std::string>> files;
+  const bool found = !r.effects.empty();
+  // Torque residual against velocity: every sample's dot, and the mean in 60 velocity bins.
+  std::vector<double> before(r.t.size()), after(r.t.size());
+  for (std::size_t i = 0; i < r.t.size(); ++i) {
+    before[i] = r.torque_measured[i] - r.torque_nominal[i];
+    after[i] = r.torque_measured[i] - r.torque_corrected[i];
+  }
+  const auto [vb, mean_before] = binned_mean(r.velocity, before, 60);
+  const auto [va, mean_after] = binned_mean(r.velocity, after, 60);
+  std::vector<Series> scatter{{"nominal", "#d77", &r.velocity, &before, false, true},
+                              {"nominal, mean", "#a11", &vb, &mean_before}};
+  if (found) {
+    scatter.push_back({"corrected", "#6b8", &r.velocity, &after, false, true});
+    scatter.push_back({"corrected, mean", "#175", &va, &mean_after});
+  }
+  files.push_back({"torque_residual_vs_velocity.svg",
+                   line_plot("Torque residual (measured drive − model's inverse dynamics) against velocity", "velocity",
+                             "torque residual", scatter, {}, {{0.0, "zero"}})});
+  // Torque over time and position over windows: the stretch around the nominal model's worst window.
+  const auto range = worst_windows(r.t, r.position, r.position_nominal, r.window_starts, 3);
+  const std::vector<double> t = slice(r.t, range), measured = slice(r.torque_measured, range),
+                            nominal = slice(r.torque_nominal, range), corrected = slice(r.torque_corrected, range);
+  std::vector<Series> torque{{"measured (filtered)", "#222", &t, &measured},
+                             {"nominal needs", "#c33", &t, &nominal, true}};
+  if (found) torque.push_back({"corrected needs", "#2a7", &t, &corrected});
+  files.push_back({"torque_over_time.svg", line_plot("Drive torque: measured, and what each model needs along the measured motion",
+                                                     "t [s]", "torque", torque)});
+  const std::vector<double> q = slice(r.position, range), qn = slice(r.position_nominal, range),
+                            qc = slice(r.position_corrected, range);
+  std::vector<Series> position{{"measured", "#222", &t, &q}, {"nominal", "#c33", &t, &qn, true}};
+  if (found) position.push_back({"corrected", "#2a7", &t, &qc});
+  std::vector<Band> windows;
+  for (std::size_t w = 0; w < r.window_starts.size(); w += 2)
+    windows.push_back({r.window_starts[w], w + 1 < r.window_starts.size() ? r.window_starts[w + 1] : r.t.back(), "#9ab"});
+  files.push_back({"position_window.svg",
+                   line_plot("Position predicted over windows restarted from the measured state (shading: every other window)",
+                             "t [s]", "position", position, windows)});
+  if (r.validation) {
+    const auto range_v = worst_windows(r.validation_t, r.validation_position, r.validation_nominal, r.validation_window_starts, 3);
+    const std::vector<double> tv = slice(r.validation_t, range_v), qv = slice(r.validation_position, range_v),
+                              qvn = slice(r.validation_nominal, range_v), qvc = slice(r.validation_corrected, range_v);
+    std::vector<Series> vp{{"measured", "#222", &tv, &qv}, {"nominal", "#c33", &tv, &qvn, true}};
+    if (found) vp.push_back({"corrected", "#2a7", &tv, &qvc});
+    files.push_back({"validation_position_window.svg",
+                     line_plot("Validation record (not fitted): position predicted over windows", "t [s]", "position", vp)});
+  }
+  std::vector<std::pair<std::string, double>> bars;
+  if (!r.rounds.empty())
+    for (const Candidate& c : r.rounds.front()) bars.push_back({c.effect, c.rms});
+  files.push_back({"candidates.svg", bar_chart("First round: torque RMS with each candidate effect fitted", bars, r.rms_before,
+                                               "best nominal " + number(r.rms_before))});
+  files.push_back({"discrepancy.json", drive_to_json(model, r)});
+  files.push_back({"corrected.toml", drive_corrected_case_file(model, r)});
+
+  std::ostringstream md;
+  md << "# Discrepancy: " << model.name << " against " << data_name << " (measured drive)\n\n";
+  md << "**Status: `" << to_string(r.status) << "`.** " << r.t.size() << " samples at " << number(r.sample_rate)
+     << " Hz. The comparison is in the torque domain: the measured drive against the torque the model needs along the "
+        "measured motion (inverse dynamics), both through the same zero-phase Butterworth low-pass (4th order, run forward "
+        "and backward) with its cut-off at "
+     << number(r.cutoff) << " Hz"
+     << (r.cutoff_from_spectrum ? " — the highest frequency at which the position's spectrum stands 100× above its noise floor (" +
+                                      number(r.spectrum_floor) + " position²/Hz)"
+                                : " (set by the user)")
+     << ".\n\n";
+  md << "Noise: position σ = " << number(r.position_noise) << ", drive σ = " << number(r.drive_noise)
+     << "; propagated through the filter and the derivatives, the torque residual's noise level is " << number(r.noise)
+     << ". At rest: |velocity| < " << number(r.rest_speed) << ".\n\n";
+  if (!r.nominal_fit.empty()) {
+    md << "## The best nominal model\n\nThe parameters the model file marks free are fitted first (torque domain, whole record):\n\n"
+       << "| parameter | given | fitted | ± (1σ) |\n|---|---|---|---|\n";
+    for (const Parameter& p : r.nominal_fit) {
+      const double given = p.name == "motor.J" ? r.given.Jm : p.name == "load.J" ? r.given.JL : p.name == "motor.F" ? r.given.Fm : r.given.FL;
+      md << "| " << p.name << " | " << number(given) << " | " << number(p.value) << " | " << number(p.uncertainty) << " |\n";
+    }
+    md << "\n";
+  }
+  if (found) {
+    md << "## Effects named\n\n| effect | parameter | value | ± (1σ) | ΔBIC when named |\n|---|---|---|---|---|\n";
+    for (const Candidate& c : r.effects)
+      for (const Parameter& p : c.parameters)
+        md << "| " << c.effect << " | " << p.name << " | " << number(p.value) << " | " << number(p.uncertainty) << " | "
+           << number(c.delta_bic) << " |\n";
+    for (const Parameter& p : r.corrected_nominal)
+      md << "| (nominal) | " << p.name << " | " << number(p.value) << " | " << number(p.uncertainty) << " | |\n";
+    md << "\nUncertainties: Ceres's covariance of the whole-record fit, scaled by the residual variance and by the residual's "
+          "integrated autocorrelation time (τ_int = "
+       << number(r.tau_int_after) << " samples: the filtered residuals are far from independent). The corrected model: "
+       << "[corrected.toml](corrected.toml).\n\n";
+  }
+  md << "## The gap\n\n| record | torque RMS, best nominal | torque RMS, corrected | position RMS over " << r.estimation.windows
+     << " windows, nominal | position RMS, corrected |\n|---|---|---|---|---|\n";
+  auto row = [&](const DriveScores& s, const std::string& label) {
+    md << "| " << label << " | " << number(s.torque_rms_nominal) << " | " << number(s.torque_rms_corrected) << " | "
+       << number(s.position_rms_nominal) << " | " << number(s.position_rms_corrected) << " |\n";
+  };
+  row(r.estimation, data_name + " (estimation)");
+  if (r.validation) row(*r.validation, validation_name + " (validation, not fitted)");
+  md << "\nThe model as given in the file: torque RMS " << number(r.rms_given) << ".\n\n";
+  md << "![torque residual against velocity](torque_residual_vs_velocity.svg)\n\n![torque over time](torque_over_time.svg)\n\n"
+     << "![position over windows](position_window.svg)\n\n";
+  if (r.validation) md << "![validation record](validation_position_window.svg)\n\n";
+  md << "## Where they disagree\n\nThe torque residual by kind of motion (a mean of opposite signs forward and backward is the "
+        "signature of Coulomb friction; one sign everywhere, that of an offset):\n\n"
+     << "| samples of | count | RMS before | mean before | RMS after | mean after |\n|---|---|---|---|---|---|\n";
+  for (const TorqueRegion& g : r.classes)
+    md << "| " << g.kind << " | " << g.samples << " | " << number(g.rms_before) << " | " << number(g.mean_before) << " | "
+       << number(g.rms_after) << " | " << number(g.mean_after) << " |\n";
+  std::vector<TorqueRegion> worst = r.stretches;
+  std::stable_sort(worst.begin(), worst.end(), [](const TorqueRegion& a, const TorqueRegion& b) { return a.rms_before > b.rms_before; });
+  if (worst.size() > 10) worst.resize(10);
+  md << "\nThe ten stretches between reversals with the largest residual before (all " << r.stretches.size()
+     << " in discrepancy.json):\n\n| from [s] | to [s] | motion | samples | RMS before | RMS after |\n|---|---|---|---|---|---|\n";
+  for (const TorqueRegion& g : worst)
+    md << "| " << number(g.t_start) << " | " << number(g.t_end) << " | " << g.kind << " | " << g.samples << " | "
+       << number(g.rms_before) << " | " << number(g.rms_after) << " |\n";
+  md << "\n## Candidates\n\nEach effect added to the current model and fitted on seven of ten blocks of the record; ΔBIC with "
+        "n_eff = n/τ_int independent residuals; decisive: ΔBIC < −10, the held-out RMS at most 0.8 of the current one, no "
+        "parameter at an end of its range.\n\n";
+  for (std::size_t k = 0; k < r.rounds.size(); ++k) {
+    md << "### Round " << k + 1 << "\n\n| effect | parameter | torque RMS | RMS held out | ΔBIC | at range edge | decisive |\n"
+       << "|---|---|---|---|---|---|---|\n";
+    for (const Candidate& c : r.rounds[k]) {
+      md << "| " << c.effect << " | ";
+      for (const Parameter& p : c.parameters) md << p.name << " = " << number(p.value) << " ";
+      md << "| " << number(c.rms) << " | " << number(c.rms_holdout) << " | " << number(c.delta_bic) << " | "
+         << (c.at_range_edge ? "yes" : "no") << " | " << (c.decisive ? "yes" : "no") << " |\n";
+    }
+    md << "\n";
+  }
+  md << "![candidates](candidates.svg)\n";
+  files.push_back({"discrepancy.md", md.str()});
+  return files;
+}
+
+}  // namespace backlash::discrepancy
