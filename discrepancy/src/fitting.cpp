@@ -88,7 +88,8 @@ struct Objective {
   const EffectCandidate& candidate;
   const std::vector<std::size_t>& indices;  ///< the samples fitted
   std::atomic<int>& calls;  ///< simulations of this fit
-  std::chrono::steady_clock::time_point deadline;  ///< past it, no further simulation
+  std::atomic<long>& work;  ///< work of this fit: 1000 per simulation plus its events
+  long budget;              ///< past it, no further simulation (deterministic, unlike a clock)
 
   ModelPoint point(const double* u) const {
     std::vector<double> values;
@@ -96,9 +97,11 @@ struct Objective {
     return candidate.apply(base, values);
   }
   std::optional<std::vector<double>> residuals_at(const double* u) const {
-    if (std::chrono::steady_clock::now() > deadline) return std::nullopt;
+    if (work.load() >= budget) return std::nullopt;
     ++calls;
-    const auto traces = simulator.traces(point(u), indices.back() + 1);
+    std::vector<numeric::SimulationEvent> events;
+    const auto traces = simulator.traces(point(u), indices.back() + 1, &events);
+    work += 1000 + static_cast<long>(events.size());
     if (!traces) return std::nullopt;
     return residuals(data, *traces, indices);
   }
@@ -242,13 +245,10 @@ std::vector<std::vector<double>> scan_starts(const Objective& objective, const E
 // nearly chaotic in it), then refined from there on horizons growing by half, the bracket
 // narrowing as the valley of the cost does.  Given a start (a refit), only the last stage runs.
 Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoint& base, const EffectCandidate& c,
-                  bool whole_record, const std::vector<double>* start_u, double seconds, double departure) {
+                  bool whole_record, const std::vector<double>* start_u, long budget, double departure) {
   Fit fit;
   std::atomic<int> calls{0};
-  const auto deadline = std::isfinite(seconds) ? std::chrono::steady_clock::now() +
-                                                    std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                        std::chrono::duration<double>(seconds))
-                                              : std::chrono::steady_clock::time_point::max();
+  std::atomic<long> work{0};
   const std::vector<std::size_t>& samples = whole_record ? data.all_indices : data.fit_indices;
   // The family validated over the candidate's whole range (its corners).
   std::vector<ModelPoint> corners;
@@ -273,7 +273,7 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
     for (; h < t_end; h = t0 + 1.5 * (h - t0)) horizons.push_back(h);
     horizons.push_back(t_end);
     const std::vector<std::size_t> first_samples = prefix(data, samples, horizons.front());
-    starts = scan_starts(Objective{simulator, data, base, c, first_samples, calls, deadline}, c);
+    starts = scan_starts(Objective{simulator, data, base, c, first_samples, calls, work, budget}, c);
   }
   // One parameter: the best two distinct valleys are followed from stage to stage (a valley
   // that looks best on a short horizon can lose on a longer one).
@@ -281,7 +281,7 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
   double cell = start_u ? 0.02 : 1.0 / 39;  // one parameter: Brent's bracket, narrowing as the horizon grows
   for (std::size_t stage = 0; stage < horizons.size(); ++stage, cell = std::max(0.004, 0.6 * cell)) {
     const std::vector<std::size_t> stage_samples = prefix(data, samples, horizons[stage]);
-    const Objective objective{simulator, data, base, c, stage_samples, calls, deadline};
+    const Objective objective{simulator, data, base, c, stage_samples, calls, work, budget};
     std::vector<Solved> found;
     for (const std::vector<double>& u : starts) {
       Solved s = k == 1 ? brent(objective, u[0], cell) : solve(objective, u, false, 25);
@@ -301,7 +301,7 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
     if (stage + 1 == horizons.size() && whole_record) best.covariance = solve(objective, best.u, true, 0).covariance;
   }
   fit.simulations = calls.load();
-  fit.budget_exhausted = std::chrono::steady_clock::now() > deadline;
+  fit.budget_exhausted = work.load() >= budget;
   fit.ok = true;
   fit.u = best.u;
   fit.sse_fit = best.sse;

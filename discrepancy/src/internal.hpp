@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -86,16 +87,18 @@ struct Fit {
   std::vector<double> uncertainty;
   double sse_fit = 0;          ///< weighted, on the fitted samples
   int simulations = 0;
-  bool budget_exhausted = false;  ///< the fit stopped at its time budget (its best point is kept)
+  bool budget_exhausted = false;  ///< the fit stopped at its work budget (its best point is kept)
 };
 
 /// Fits a candidate added to `base`: the scan, then Ceres from the best points.  With
 /// `whole_record` the fit uses every sample and the covariance is computed.
-/// The fit stops at `seconds` (its best point kept; Fit::budget_exhausted says so).
+/// The fit stops when its work (1000 per simulation plus the events simulated) reaches `budget`
+/// (its best point kept; Fit::budget_exhausted says so) — a count, so the result does not depend
+/// on the machine's speed or load.
 /// `departure`: where the base model first leaves the record's noise band — the first stage of
 /// the growing horizon ends a quarter servo period after it.
 Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoint& base, const EffectCandidate& c,
-                  bool whole_record, const std::vector<double>* start_u = nullptr, double seconds = INFINITY,
+                  bool whole_record, const std::vector<double>* start_u = nullptr, long budget = std::numeric_limits<long>::max(),
                   double departure = NAN);
 
 }  // namespace backlash::discrepancy::detail

@@ -68,7 +68,7 @@ std::string to_json(const model::CaseSpec& model, const DiscrepancyResult& r, do
                           {"decisive", c.decisive},
                           {"at_range_edge", c.at_range_edge},
                           {"simulations", c.simulations},
-                          {"seconds", c.seconds}};
+                          {"failure", c.failure}};
       round.push_back(item);
       if (k == 0) candidates.push_back(item);
     }
@@ -109,8 +109,7 @@ std::string to_json(const model::CaseSpec& model, const DiscrepancyResult& r, do
                        {"nominal", features_json(r.nominal)},
                        {"corrected", features_json(r.corrected)}}},
                      {"events", {{"nominal", events_json(r.nominal_events)}, {"corrected", events_json(r.corrected_events)}}},
-                     {"simulations", r.simulations},
-                     {"seconds", r.seconds}};
+                     {"simulations", r.simulations}};
   return out.dump(2) + "\n";
 }
 
@@ -181,13 +180,13 @@ std::vector<std::pair<std::string, std::string>> report_files(const model::CaseS
   md << "\n## Candidates\n\nEach effect added to the model and fitted on the first part of the record; scored by its BIC there "
         "and its RMS on the held-out rest. Decisive: ΔBIC < −10 and the held-out RMS reduced enough.\n\n";
   for (std::size_t k = 0; k < r.rounds.size(); ++k) {
-    md << "### Round " << k + 1 << "\n\n| effect | parameters | RMS | RMS held out (weighted) | ΔBIC | decisive | simulations | time [s] |\n"
-       << "|---|---|---|---|---|---|---|---|\n";
+    md << "### Round " << k + 1 << "\n\n| effect | parameters | RMS | RMS held out (weighted) | ΔBIC | decisive | simulations |\n"
+       << "|---|---|---|---|---|---|---|\n";
     for (const Candidate& c : r.rounds[k]) {
       md << "| " << c.effect << " | ";
       for (const Parameter& p : c.parameters) md << p.name << " = " << number(p.value) << " ";
       md << "| " << number(c.rms) << " | " << number(c.rms_holdout) << " | " << number(c.delta_bic) << " | "
-         << (c.decisive ? "yes" : "no") << " | " << c.simulations << " | " << number(c.seconds) << " |\n";
+         << (c.decisive ? "yes" : "no") << " | " << c.simulations << " |\n";
     }
     md << "\n";
   }

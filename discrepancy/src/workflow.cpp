@@ -168,9 +168,9 @@ std::vector<Trial> round_of(Simulator& simulator, const Observations& o, const M
       t.candidate = detail::candidate_for(effects[i], current, step);
       t.result.effect = effects[i];
       try {
-        t.fit = detail::fit_candidate(simulator, o, current, t.candidate, false, nullptr, options.candidate_seconds, departure);
+        t.fit = detail::fit_candidate(simulator, o, current, t.candidate, false, nullptr, options.candidate_work, departure);
         if (t.fit.budget_exhausted)
-          t.result.failure = "its fit reached the time budget of " + std::to_string(options.candidate_seconds) + " s";
+          t.result.failure = "its fit reached the work budget of " + std::to_string(options.candidate_work) + " (1000 per simulation plus its events)";
       } catch (const std::exception& error) {  // a candidate that cannot be simulated is a failed candidate
         t.fit = detail::Fit{};
         t.result.failure = error.what();

@@ -33,9 +33,10 @@ struct CommandRun {
   std::string out, err;
 };
 
-CommandRun run(const std::string& arguments) {
+// A shell command line; stdout and stderr apart.
+CommandRun run_shell(const std::string& line) {
   const std::string err_file = fs::temp_directory_path() / ("backlash-discrepancy-test-" + std::to_string(::getpid()) + ".err");
-  const std::string command = std::string(BACKLASH_CLI) + " " + arguments + " 2> " + err_file;
+  const std::string command = "(" + line + ") 2> " + err_file;
   FILE* pipe = popen(command.c_str(), "r");
   std::string out;
   std::array<char, 4096> buffer;
@@ -46,6 +47,8 @@ CommandRun run(const std::string& arguments) {
   fs::remove(err_file);
   return {WEXITSTATUS(status), out, err};
 }
+
+CommandRun run(const std::string& arguments) { return run_shell(std::string(BACKLASH_CLI) + " " + arguments); }
 
 class Folder {
  public:
@@ -214,6 +217,36 @@ TEST(DiscrepancyCommand, exam_EmpsFromTheMatFileNamesCoulombAndOffsetAndWritesTh
     EXPECT_TRUE(std::find(names.begin(), names.end(), expected) != names.end()) << "no " << expected << " in --out";
   for (const std::string& name : names)
     EXPECT_EQ(read(folder / "a" / name), read(folder / "b" / name)) << name << " differs between two runs";
+}
+
+// The README's discrepancy commands, as printed there, run from the source folder (the --out
+// folder moved to a temporary one), and say what the README says they say.
+TEST(DiscrepancyCommand, exam_TheReadmeExamplesRunAndSayWhatTheReadmeSays) {
+  std::ifstream readme(fs::path(BACKLASH_SOURCE_DIR) / "README.md");
+  std::vector<std::string> commands;
+  for (std::string line; std::getline(readme, line);)
+    if (line.rfind("build/bin/backlash discrepancy", 0) == 0) commands.push_back(line);
+  ASSERT_EQ(commands.size(), 2u) << "the README has " << commands.size() << " discrepancy examples instead of 2";
+  Folder folder;
+  int k = 0;
+  for (std::string command : commands) {
+    SCOPED_TRACE(command);
+    const std::size_t out = command.find(" --out ");
+    ASSERT_NE(out, std::string::npos);
+    command = command.substr(std::string("build/bin/backlash ").size(), out - std::string("build/bin/backlash ").size()) +
+              " --out " + (folder / ("out" + std::to_string(k++))).string();
+    const CommandRun r = run_shell("cd " + std::string(BACKLASH_SOURCE_DIR) + " && " + BACKLASH_CLI + " " + command);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("effect_found"), std::string::npos) << r.out;
+    if (command.find("hidden_friction") != std::string::npos) {
+      EXPECT_NE(r.out.find("coulomb_load    torque = 0.0200002"), std::string::npos) << r.out;
+    } else {
+      EXPECT_NE(r.out.find("coulomb_motor   torque = 20.31"), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find("torque_offset   torque = 3.168"), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find("torque RMS: 9.793 before (best nominal), 2.51 after"), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find("torque RMS 10.53 before, 4.236 after"), std::string::npos) << r.out;
+    }
+  }
 }
 
 }  // namespace

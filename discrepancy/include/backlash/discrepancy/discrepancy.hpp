@@ -103,7 +103,10 @@ struct DiscrepancyOptions {
   int max_effects = 3;
   std::vector<std::string> candidates = vocabulary();  ///< which effects to try
   int threads = 2;                ///< candidates fitted in parallel (numeric work: threads)
-  double candidate_seconds = 3;   ///< a candidate's fit stops here with its best point (a stiff mesh can be slow)
+  /// A candidate's fit stops with its best point when its work — 1000 per simulation plus the
+  /// events it simulated — reaches this (a stiff mesh can be slow).  A count, not a clock, so that
+  /// the result is the same on any machine; 3e6 is about 3 s of a stiff mesh's fit here.
+  long candidate_work = 3'000'000;
 };
 
 struct DiscrepancyResult {
