@@ -1,0 +1,143 @@
+// time_ benchmarks of the effects (not timed tests): case V's step of 0.62 over 60 s,
+//   time_NominalClosedForm              the thesis's model on the closed forms (simulate_step);
+//   time_EffectsClosedForm/<effect>     with one effect, on the closed-form engine
+//                                       (simulate_effects_step; the delay by the method of steps);
+//   time_EffectsOdeint/<effect>         the same on the independent Boost.Odeint simulator at the
+//                                       tolerance the cross-check uses (1e-13: event times within
+//                                       ~4e-10 s of the closed form).
+// The ratio odeint / closed form per effect is printed after the table (one run).
+// Validation (the gate) happens once per effect, outside the timed loops.
+#include "backlash/model/case_spec.hpp"
+#include "backlash/numeric/effects.hpp"
+#include "backlash/numeric/effects_simulation.hpp"
+#include "backlash/numeric/evaluator.hpp"
+#include "backlash/numeric/hybrid_simulation.hpp"
+#include "backlash/numeric/odeint_effects_simulation.hpp"
+#include "backlash/numeric/parametric.hpp"
+#include "backlash/numeric/validation.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace backlash;
+
+constexpr double step = 0.62, t_end = 60;
+
+struct Effect {
+  std::string name;
+  numeric::Effects effects;
+};
+
+const std::vector<Effect>& effects() {
+  static const std::vector<Effect> list = [] {
+    std::vector<Effect> l;
+    auto add = [&](const std::string& name, auto&& set) {
+      numeric::Effects e;
+      set(e);
+      l.push_back({name, e});
+    };
+    add("coulomb_load=0.03", [](numeric::Effects& e) { e.coulomb_load = 0.03; });
+    add("coulomb_motor=0.02", [](numeric::Effects& e) { e.coulomb_motor = 0.02; });
+    add("restitution=0.4", [](numeric::Effects& e) { e.restitution = 0.4; });
+    add("saturation=0.1", [](numeric::Effects& e) { e.saturation = 0.1; });
+    add("compliance=400/4", [](numeric::Effects& e) { e.mesh_stiffness = 400, e.mesh_damping = 4; });
+    add("delay=0.05", [](numeric::Effects& e) { e.delay = 0.05; });
+    add("torque_offset=0.02", [](numeric::Effects& e) { e.torque_offset = 0.02; });
+    return l;
+  }();
+  return list;
+}
+
+const numeric::ValidationResult& nominal() {
+  static const numeric::ValidationResult v = numeric::validate(numeric::case_evaluator(model::load_case("V")));
+  return v;
+}
+
+const numeric::ValidatedEffectModel& validated(const numeric::Effects& e) {
+  static std::map<std::string, std::unique_ptr<numeric::EffectValidationResult>> cache;
+  std::unique_ptr<numeric::EffectValidationResult>& slot = cache[e.describe()];
+  if (!slot) slot = std::make_unique<numeric::EffectValidationResult>(numeric::validate_effects(nominal().evaluator(), e));
+  return slot->model();
+}
+
+numeric::SimulationOptions options() {
+  numeric::SimulationOptions o;
+  o.t_end = t_end;
+  o.general_engine = true;
+  return o;
+}
+
+std::map<std::string, double> closed_ns, odeint_ns;
+
+void time_NominalClosedForm(benchmark::State& state) {
+  numeric::SimulationOptions o;
+  o.t_end = t_end;
+  for (auto _ : state) benchmark::DoNotOptimize(numeric::simulate_step(nominal().evaluator(), step, o));
+}
+BENCHMARK(time_NominalClosedForm)->Unit(benchmark::kMicrosecond);
+
+void time_EffectsClosedForm(benchmark::State& state) {
+  const Effect& e = effects()[static_cast<std::size_t>(state.range(0))];
+  state.SetLabel(e.name);
+  const numeric::ValidatedEffectModel& model = validated(e.effects);
+  const numeric::SimulationOptions o = options();
+  std::size_t events = 0;
+  for (auto _ : state) {
+    const numeric::SimulationResult r = numeric::simulate_effects_step(model, step, o);
+    events = r.events.size();
+    benchmark::DoNotOptimize(r);
+  }
+  state.counters["events"] = static_cast<double>(events);
+}
+BENCHMARK(time_EffectsClosedForm)->DenseRange(0, 6)->Unit(benchmark::kMicrosecond);
+
+void time_EffectsOdeint(benchmark::State& state) {
+  const Effect& e = effects()[static_cast<std::size_t>(state.range(0))];
+  state.SetLabel(e.name);
+  const numeric::Parameters p = numeric::parameters_of(model::load_case("V"));
+  const numeric::SimulationOptions o = options();
+  numeric::OdeintSimulationOptions odeint;
+  odeint.tolerance = 1e-13;
+  for (auto _ : state) benchmark::DoNotOptimize(numeric::simulate_effects_step_with_odeint(p, e.effects, step, o, odeint));
+}
+BENCHMARK(time_EffectsOdeint)->DenseRange(0, 6)->Unit(benchmark::kMicrosecond);
+
+// Collects the per-effect times for the ratio table.
+class Ratios : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& run : runs) {
+      const std::string name = run.benchmark_name();
+      const double ns = run.GetAdjustedRealTime() * (run.time_unit == benchmark::kMicrosecond ? 1e3 : 1);
+      if (name.rfind("time_EffectsClosedForm", 0) == 0) closed_ns[run.report_label] = ns;
+      if (name.rfind("time_EffectsOdeint", 0) == 0) odeint_ns[run.report_label] = ns;
+      if (name.rfind("time_NominalClosedForm", 0) == 0) nominal_ns = ns;
+    }
+    ConsoleReporter::ReportRuns(runs);
+  }
+  double nominal_ns = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  Ratios reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  std::printf("\ncase V, step 0.62, 60 s (one run): closed form with the effect, its cost against the nominal model, "
+              "and odeint's time against it\n");
+  std::printf("%-20s %12s %12s %12s %10s\n", "effect", "closed [us]", "/ nominal", "odeint [us]", "odeint/cf");
+  for (const auto& [label, ns] : closed_ns) {
+    const double o = odeint_ns.count(label) ? odeint_ns[label] : 0;
+    std::printf("%-20s %12.1f %12.2f %12.1f %10.1f\n", label.c_str(), ns / 1e3,
+                reporter.nominal_ns > 0 ? ns / reporter.nominal_ns : 0.0, o / 1e3, o > 0 ? o / ns : 0.0);
+  }
+  benchmark::Shutdown();
+}
