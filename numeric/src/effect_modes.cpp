@@ -10,6 +10,7 @@
 #include <complex>
 #include <limits>
 #include <sstream>
+#include <vector>
 
 namespace backlash::numeric {
 
@@ -100,26 +101,65 @@ struct ModeFlow::Generic {
   ComplexVector5 lambda, q;
   ComplexMatrix5 V;
 
+  // The eigen-decomposition of an augmented matrix, kept per thread for the last few matrices:
+  // a mesh mode is entered again and again with the same matrix (the gap constant snapped to
+  // the face makes the augmentation column repeat), and the decomposition is most of a mesh
+  // segment's cost.  Exact comparison of the matrix: a hit gives the same bits as a recomputation.
+  struct Decomposition {
+    Matrix5 M;
+    int m = 0;
+    bool diagonal = false;
+    ComplexVector5 lambda;
+    ComplexMatrix5 V, inverse;
+  };
+  static const Decomposition& decomposition(const Matrix5& M, int m) {
+    thread_local std::vector<Decomposition> cache;
+    thread_local std::size_t next = 0;
+    for (const Decomposition& d : cache)
+      if (d.m == m && d.M == M) return d;
+    Decomposition d;
+    d.M = M;
+    d.m = m;
+    d.lambda = ComplexVector5::Zero();
+    d.V = ComplexMatrix5::Zero();
+    d.inverse = ComplexMatrix5::Zero();
+    Eigen::EigenSolver<Eigen::MatrixXd> solver(M.topLeftCorner(m, m), true);
+    if (solver.info() == Eigen::Success) {
+      const Eigen::MatrixXcd vectors = solver.eigenvectors();
+      Eigen::PartialPivLU<Eigen::MatrixXcd> lu(vectors);
+      const Eigen::MatrixXcd inverse = lu.inverse();
+      const double condition =
+          vectors.cwiseAbs().rowwise().sum().maxCoeff() * inverse.cwiseAbs().rowwise().sum().maxCoeff();
+      if (std::isfinite(condition) && condition <= 1e7) {
+        d.V.topLeftCorner(m, m) = vectors;
+        d.inverse.topLeftCorner(m, m) = inverse;
+        d.lambda.head(m) = solver.eigenvalues();
+        d.diagonal = true;
+      }
+    }
+    constexpr std::size_t capacity = 16;
+    if (cache.size() < capacity) {
+      cache.push_back(std::move(d));
+      return cache.back();
+    }
+    cache[next] = std::move(d);
+    const std::size_t at = next;
+    next = (next + 1) % capacity;
+    return cache[at];
+  }
+
   Generic(const LinearSegment& s, const SmallVector& start) : n(static_cast<int>(s.A.rows())) {
     M.topLeftCorner(n, n) = s.A;
     M.block(0, n, n, 1) = s.c;
     z0.head(n) = start;
     z0(n) = 1;
     const int m = n + 1;
-    Eigen::EigenSolver<Eigen::MatrixXd> solver(M.topLeftCorner(m, m), true);
-    if (solver.info() != Eigen::Success) return;
-    const Eigen::MatrixXcd vectors = solver.eigenvectors();
-    const Eigen::VectorXcd values = solver.eigenvalues();
-    Eigen::PartialPivLU<Eigen::MatrixXcd> lu(vectors);
-    const Eigen::MatrixXcd inverse = lu.inverse();
-    const double condition = vectors.cwiseAbs().rowwise().sum().maxCoeff() * inverse.cwiseAbs().rowwise().sum().maxCoeff();
-    if (!std::isfinite(condition) || condition > 1e7) return;
-    V = ComplexMatrix5::Zero();
-    V.topLeftCorner(m, m) = vectors;
-    lambda = ComplexVector5::Zero();
-    lambda.head(m) = values;
+    const Decomposition& d = decomposition(M, m);
+    if (!d.diagonal) return;
+    V = d.V;
+    lambda = d.lambda;
     q = ComplexVector5::Zero();
-    q.head(m) = inverse * z0.head(m).cast<std::complex<double>>();
+    q.head(m) = d.inverse.topLeftCorner(m, m) * z0.head(m).cast<std::complex<double>>();
     diagonal = true;
   }
 
