@@ -241,10 +241,10 @@ TEST(DiscrepancyCommand, exam_TheReadmeExamplesRunAndSayWhatTheReadmeSays) {
     if (command.find("hidden_friction") != std::string::npos) {
       EXPECT_NE(r.out.find("coulomb_load    torque = 0.0200002"), std::string::npos) << r.out;
     } else {
-      EXPECT_NE(r.out.find("coulomb_motor   torque = 20.31"), std::string::npos) << r.out;
-      EXPECT_NE(r.out.find("torque_offset   torque = 3.168"), std::string::npos) << r.out;
-      EXPECT_NE(r.out.find("torque RMS: 9.793 before (best nominal), 2.51 after"), std::string::npos) << r.out;
-      EXPECT_NE(r.out.find("torque RMS 10.53 before, 4.236 after"), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find("coulomb_motor   torque = 20.3941"), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find("torque_offset   torque = 3.25104"), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find("torque RMS: 9.451 before (best nominal), 2.065 after"), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find("torque RMS 9.695 before, 2.609 after"), std::string::npos) << r.out;
     }
   }
 }

@@ -144,7 +144,7 @@ std::vector<std::pair<std::string, std::string>> report_files(const model::CaseS
                                                               const std::string& data_name,
                                                               const DiscrepancyResult& result, double step);
 
-/// The JSON document of `discrepancy --json` (DESIGN.md §3's keys and more).
+/// The JSON document of `discrepancy --json` (docs/design.md, "JSON keys", and more).
 std::string to_json(const model::CaseSpec& model, const DiscrepancyResult& result, double step);
 
 /// The corrected model as a case file: the nominal file's parameters, the backlash if it was

@@ -10,13 +10,16 @@
 //
 // The comparison is in the torque domain (inverse dynamics): the torque the model needs along
 // the MEASURED motion against the measured drive,
-//     r(t) = û(t − τ) + T0 − (J·â + F·v̂ + Tc·sgn v̂)          [torque]
+//     r = filter(Ū − φ) + T0 − (J·â + F·v̂)          [torque]
 // where v̂, â are derivatives of the measured position through a zero-phase low-pass
-// (Butterworth, forward–backward) and û is the drive through the same filter (both sides see
-// the same band).  The cut-off is the user's, or the highest frequency at which the position's
-// spectrum stands 100× (20 dB) above its noise floor (measurements/inverse_dynamics_signals.hpp).
-// At rest (|v̂| below the speed a noise-sized motion at the cut-off would have) a model with
-// Coulomb friction holds any torque within ±Tc: there r is the part outside that band.
+// (Butterworth, forward–backward), Ū the logged drive clipped at ±L and held (zero-order hold,
+// delayed by τ) as the second difference of the position sees it (quadratic B-spline weights),
+// φ the friction — Tc·s̄ moving (s̄ the average of sgn v), at rest the force that holds the
+// drive (Ū + T0 within ±Tc) or Tc·sgn(Ū + T0) — all through the same filter
+// (docs/discrepancy.md).  The cut-off is the user's, or the highest frequency at which the
+// position's spectrum stands 100× (20 dB) above its noise floor
+// (measurements/inverse_dynamics_signals.hpp).  The filter's end transients, and the samples
+// within the filter's length of a start, a stop or a reversal, are not compared.
 // The torque residual is also checked where it matters to a user, in position: the model,
 // restarted from the measured state at the start of every window (0.5 s by default), predicts
 // the position over the window (numeric/measured_drive.hpp, exact for the zero-order-hold
@@ -37,7 +40,8 @@
 //      residual's integrated autocorrelation time: filtered 1 kHz residuals are far from
 //      independent), its held-out RMS ≤ decisive_holdout × the current one, and no parameter at
 //      an end of its range.  The most decisive is named, the whole model refitted on the whole
-//      record, the search repeated;
+//      record, the search repeated; when no single candidate is decisive, pairs are tried by
+//      the same rule (two parameters' penalty);
 //   4. uncertainties are one standard deviation from the least-squares covariance
 //      s²(AᵀA)⁻¹ (A the Jacobian of the residual, a delay's or limit's column by central
 //      differences) inflated by τ_int;
@@ -143,7 +147,7 @@ std::vector<std::pair<std::string, std::string>> drive_report_files(const model:
                                                                     const std::string& validation_name,
                                                                     const DriveDiscrepancyResult& result);
 
-/// The JSON of `discrepancy --json` (DESIGN.md §3's keys, torque RMS in rms_before/rms_after).
+/// The JSON of `discrepancy --json` (docs/design.md, "JSON keys"; torque RMS in rms_before/rms_after).
 std::string drive_to_json(const model::CaseSpec& model, const DriveDiscrepancyResult& result);
 
 /// The corrected model as a case file: refitted nominal parameters, the named effects.
