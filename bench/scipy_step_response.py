@@ -2,7 +2,7 @@
 """SciPy baseline for bench/compare_simulation.sh: the hybrid step response of a
 case file, with SciPy's solve_ivp and its `events`.
 
-The same automaton and event semantics as backlash's simulators (DESIGN.md §1,
+The same automaton and event semantics as backlash's simulators (docs/physics.md,
 numeric/include/backlash/numeric/hybrid_simulation.hpp):
   start        at rest, in contact on the face that drives toward θR (σ = −1 for a
                step A ≥ 0, else +1), θo = θR − A;
@@ -21,7 +21,7 @@ numeric/include/backlash/numeric/hybrid_simulation.hpp):
                event is the last time a velocity was ≥ 1e-9.
 
 solve_ivp checks event signs only at step ends (a double crossing inside one step is
-missed — scipy/scipy#9135-style behaviour, DESIGN.md §4), so max_step is bounded by
+missed — scipy/scipy#9135-style behaviour, docs/design.md, "Facts about the tools"), so max_step is bounded by
 0.1 / (the fastest rate of the modes), the same bound as the odeint simulator's.
 
 Tolerance.  rtol = atol = 1e-10 with DOP853 (the default here), max_step as above.

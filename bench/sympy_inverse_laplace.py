@@ -2,7 +2,7 @@
 """SymPy baseline for backlash's symbolic engine.
 
 Times sympy.inverse_laplace_transform on the same inverse Laplace transforms
-that symbolic/ derives (docs: DESIGN.md section 1), so that the C++ benchmark
+that symbolic/ derives (docs/physics.md), so that the C++ benchmark
 can print a speed ratio.  Per case, five transforms:
 
   contact_theta_o   Θo(s) = (J(s a + b) + F a + K θR/s) / (J s² + F s + K)

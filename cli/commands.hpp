@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -17,6 +18,22 @@ namespace backlash::cli {
 class UsageError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+/// A computation that ended before its end time without the model having stopped by
+/// itself (numeric::stopped_early): the output printed so far is correct and complete up to
+/// `t`; main() says so on stderr in one line and exits 3.
+class StoppedEarly : public std::runtime_error {
+ public:
+  StoppedEarly(double t, const std::string& status, const std::string& reason)
+      : std::runtime_error("stopped early at t = " + number(t) + " (" + status + "): " + reason) {}
+
+ private:
+  static std::string number(double t) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.10g", t);
+    return text;
+  }
 };
 
 void register_derive_command(CLI::App& app);   // cli/derive_command.cpp

@@ -1,5 +1,5 @@
 // `backlash import FILE.mat --out FILE.csv [--format emps]` — a measured record
-// of a real drive in the project's CSV (DESIGN.md §3 "Measured data"), for the
+// of a real drive in the project's CSV (docs/design.md, "Measured data (CSV)"), for the
 // discrepancy workflow's measured-drive experiments.
 //
 // EMPS (measurements/emps.hpp): t → t [s], qm → theta_out [m], the drive force

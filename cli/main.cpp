@@ -5,6 +5,8 @@
 //   0  success, and --help (CLI11 prints it through app.exit)
 //   2  bad usage or bad input (CLI11 parse errors, UsageError, CaseFileError)
 //   1  any other failure
+//   3  a simulation stopped before its end time (chattering, event cap, non-finite,
+//      unresolved, work limit): what was computed is printed, the reason is on stderr
 // CLI11's own failure printer uses two lines and exit codes above 100; parse
 // errors are reported here in the one-line form with exit code 2 instead.
 #include "commands.hpp"
@@ -23,13 +25,14 @@ namespace {
 
 constexpr int exit_code_for_bad_input = 2;
 constexpr int exit_code_for_failure = 1;
+constexpr int exit_code_for_early_stop = 3;
 
 /// Prints "backlash: error: <message>" as exactly one line on stderr.
-int report_error(std::string message, int exit_code) {
+int report_error(std::string message, int exit_code, const char* prefix = "backlash: error: ") {
   for (char& character : message)
     if (character == '\n' || character == '\r') character = ' ';
   while (!message.empty() && message.back() == ' ') message.pop_back();
-  std::cerr << "backlash: error: " << message << '\n';
+  std::cerr << prefix << message << '\n';
   return exit_code;
 }
 
@@ -57,6 +60,8 @@ int main(int argument_count, char** arguments) {
   } catch (const CLI::ParseError& parse_error) {
     if (parse_error.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(parse_error);
     return report_error(std::string(parse_error.what()) + " (run with --help for usage)", exit_code_for_bad_input);
+  } catch (const backlash::cli::StoppedEarly& early) {
+    return report_error(early.what(), exit_code_for_early_stop, "backlash: ");
   } catch (const backlash::cli::UsageError& usage_error) {
     return report_error(usage_error.what(), exit_code_for_bad_input);
   } catch (const backlash::model::CaseFileError& case_file_error) {

@@ -9,11 +9,15 @@
 
 #include "backlash/model/case_spec.hpp"
 #include "backlash/numeric/effects_simulation.hpp"
+#include "backlash/numeric/scales.hpp"
 #include "backlash/numeric/validation.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -29,8 +33,18 @@ struct ValidatedCase {
   const numeric::ValidatedEffectModel& model() const { return effects.model(); }
 };
 
+/// Refuses, before any work, parameters whose rates double precision or the event searches
+/// cannot handle (numeric/scales.hpp): bad input, "FILE: K, motor.J: problem".
+inline void check_parameter_scales(const model::CaseSpec& spec) {
+  numeric::Parameters p = numeric::parameters_of(spec);
+  p.theta_R = 0;  // the numerics run in error coordinates: θR plays no part
+  if (const std::optional<std::string> problem = numeric::parameter_scale_problem(p))
+    throw model::CaseFileError(spec.source, 0, "", "cannot be computed in double precision: " + *problem);
+}
+
 inline ValidatedCase validated_case(const std::string& case_name) {
   model::CaseSpec spec = model::load_case(case_name);
+  check_parameter_scales(spec);
   numeric::ValidationResult result = numeric::validate(numeric::case_evaluator(spec));
   if (!result.passed()) {
     std::string failing;
@@ -57,17 +71,28 @@ inline nlohmann::json effects_json(const numeric::Effects& e) {
   return out;
 }
 
-/// A finite number, or UsageError naming the flag.
+/// A finite number, or UsageError naming the flag and what is wrong: not a number at all, or
+/// one double precision cannot hold (beyond ±1.8e308, or nonzero below 2.2e-308 in size, where
+/// it keeps fewer digits — use 0 or a larger value).
 inline double parse_number(const std::string& text, const std::string& flag) {
-  std::size_t used = 0;
-  double value = 0;
-  try {
-    value = std::stod(text, &used);
-  } catch (...) {
-    throw UsageError(flag + ": '" + text + "' is not a number");
-  }
-  if (used != text.size()) throw UsageError(flag + ": '" + text + "' is not a number");
-  if (!std::isfinite(value)) throw UsageError(flag + ": '" + text + "' is not finite");
+  const auto first = text.find_first_not_of(" \t");
+  if (first == std::string::npos) throw UsageError(flag + ": empty value");
+  const std::string trimmed = text.substr(first, text.find_last_not_of(" \t") - first + 1);
+  const char* begin = trimmed.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(begin, &end);
+  const int range = errno;
+  if (end == begin || *end != '\0') throw UsageError(flag + ": '" + text + "' is not a number");
+  if (std::isnan(value) || (std::isinf(value) && range != ERANGE)) throw UsageError(flag + ": '" + text + "' is not finite");
+  if (range == ERANGE && std::isinf(value))
+    throw UsageError(flag + ": '" + text + "' is too large for double precision (beyond 1.8e308)");
+  if (value != 0 && !std::isnormal(value))
+    throw UsageError(flag + ": '" + text + "' is too small for double precision (nonzero below 2.2e-308 in size); "
+                     "use 0 or a larger value");
+  if (range == ERANGE && value == 0)
+    throw UsageError(flag + ": '" + text + "' is too small for double precision (nonzero below 2.2e-308 in size); "
+                     "use 0 or a larger value");
   return value;
 }
 

@@ -1,13 +1,15 @@
 // `backlash simulate CASE --step A [--t-end T] [--csv|--json]` — the exact
-// event-driven step response (DESIGN.md §1: start at rest in contact, θo = θR − A).
+// event-driven step response (docs/physics.md: start at rest in contact, θo = θR − A).
 #include "commands.hpp"
 #include "numeric_case.hpp"
 
 #include "backlash/numeric/effects_simulation.hpp"
 #include "backlash/numeric/hybrid_simulation.hpp"
+#include "backlash/numeric/scales.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -42,17 +44,34 @@ void run_simulate(const SimulateOptions& options) {
     step = model::to_double(c.spec.experiment->step);
   }
   if (!t_end) t_end = c.spec.experiment && c.spec.experiment->t_end ? model::to_double(*c.spec.experiment->t_end) : 60.0;
+  // A step whose motion double precision cannot resolve against the backlash is refused
+  // before any work (numeric/scales.hpp): an answer there would be rounding noise.
+  const numeric::Parameters& parameters = c.evaluator().parameters();
+  const std::string step_text = options.step ? *options.step : "of the case file";
+  if (auto problem = numeric::resolution_problem(parameters, std::fabs(*step), "the step " + step_text))
+    throw UsageError("--step: " + *problem);
   numeric::SimulationOptions sim;
   sim.t_end = *t_end;
-  if (options.csv) sim.sample_interval = dt;
-  const numeric::SimulationResult r = numeric::simulate_effects_step(c.model(), *step, sim);
   const numeric::Effects& effects = c.model().effects();
-  const double final_error = r.theta_o_final - c.evaluator().parameters().theta_R;
   if (options.csv) {
+    // Streamed: each sample is printed as soon as it is computed (memory does not grow with
+    // the number of rows); an early stop is said in a last comment line and on stderr.
+    sim.sample_interval = dt;
+    const char* contact_mode = effects.compliant() ? "mesh" : "contact";
     std::printf("t,theta_o,dtheta_o,theta_m,dtheta_m,theta_L,dtheta_L,mode\n");
-    for (const numeric::TrajectorySample& s : r.samples)
-      std::printf("%.10g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%s\n", s.t, s.theta_o, s.dtheta_o, s.theta_m, s.dtheta_m, s.theta_L,
-                  s.dtheta_L, s.in_contact ? (effects.compliant() ? "mesh" : "contact") : "free");
+    sim.sample_sink = [contact_mode](const numeric::TrajectorySample& s) {
+      std::printf("%.10g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%s\n", s.t, s.theta_o, s.dtheta_o, s.theta_m, s.dtheta_m,
+                  s.theta_L, s.dtheta_L, s.in_contact ? contact_mode : "free");
+    };
+  }
+  const numeric::SimulationResult r = numeric::simulate_effects_step(c.model(), *step, sim);
+  const double final_error = r.theta_o_final - parameters.theta_R;
+  const bool early = numeric::stopped_early(r.status);
+  if (options.csv) {
+    if (early)
+      std::printf("# stopped early at t = %.10g: %s: %s\n", r.t_final, numeric::to_string(r.status), r.stop_reason.c_str());
+    std::fflush(stdout);
+    if (early) throw StoppedEarly(r.t_final, numeric::to_string(r.status), r.stop_reason);
     return;
   }
   if (options.json) {
@@ -86,7 +105,9 @@ void run_simulate(const SimulateOptions& options) {
                          {"in_contact", r.final_state.in_contact},
                          {"motor_stuck", r.final_state.motor_stuck},
                          {"load_stuck", r.final_state.load_stuck}}}};
-    std::cout << out.dump(2) << "\n";
+    if (early) out["stop_reason"] = r.stop_reason;
+    std::cout << out.dump(2) << "\n" << std::flush;
+    if (early) throw StoppedEarly(r.t_final, numeric::to_string(r.status), r.stop_reason);
     return;
   }
   std::printf("%s, step %g over %g s: %s, %zu events (effects: %s)\n", c.spec.id.c_str(), *step, *t_end,
@@ -97,6 +118,11 @@ void run_simulate(const SimulateOptions& options) {
                 e.body != numeric::Body::None ? (std::string("  ") + numeric::to_string(e.body)).c_str() : "");
   std::printf("final: t = %g  theta_o = %.10f  theta_m = %.10f  theta_L = %.10f  error theta_o - theta_R = %.10f\n",
               r.t_final, r.theta_o_final, r.final_state.theta_m, r.final_state.theta_L, final_error);
+  if (early) {
+    std::printf("stopped early at t = %.10g (%s): %s\n", r.t_final, numeric::to_string(r.status), r.stop_reason.c_str());
+    std::fflush(stdout);
+    throw StoppedEarly(r.t_final, numeric::to_string(r.status), r.stop_reason);
+  }
 }
 
 }  // namespace

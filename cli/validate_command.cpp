@@ -7,12 +7,14 @@
 // formulas of its branches.  With --branches: the parametric and direct
 // evaluators at a representative point of each of the 14 pole-structure branches.
 #include "commands.hpp"
+#include "numeric_case.hpp"
 
 #include "backlash/model/case_spec.hpp"
 #include "backlash/numeric/validation.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -72,19 +74,24 @@ void print_report(std::ostream& out, const numeric::ValidationReport& r) {
 void run_validate(const ValidateOptions& options) {
   if (options.case_name.empty() && !options.branches)
     throw UsageError("validate: give a CASE (I..VIII or a case file) and/or --branches");
-  if (!(options.tolerance > 0)) throw UsageError("validate: --tolerance must be positive");
+  if (!(options.tolerance > 0) || !std::isfinite(options.tolerance))
+    throw UsageError("--tolerance: must be a finite number > 0");
   numeric::ValidationOptions gate;
   gate.tolerance = options.tolerance;
 
   std::optional<model::CaseSpec> spec;
-  if (!options.case_name.empty()) spec = model::load_case(options.case_name);  // bad input fails before any output
+  if (!options.case_name.empty()) {
+    spec = model::load_case(options.case_name);  // bad input fails before any output
+    check_parameter_scales(*spec);                // and what double precision cannot compute, before any work
+  }
 
   nlohmann::json document;
   std::ostringstream text;
   std::vector<std::string> failures;
   auto run = [&](const numeric::EvaluatorPtr& evaluator, const std::string& where) {
     const numeric::ValidationResult result = numeric::validate(evaluator, gate);
-    if (!result.passed()) failures.push_back(where + ": " + result.report().evaluator);
+    if (!result.passed())
+      failures.push_back(where + ": " + result.report().evaluator + " (" + result.report().failures() + ")");
     print_report(text, result.report());
     return to_json(result.report());
   };
@@ -120,15 +127,17 @@ void run_validate(const ValidateOptions& options) {
   }
   document["tolerance"] = gate.tolerance;
   document["passed"] = failures.empty();
-  if (options.json)
-    std::cout << document.dump(2) << "\n";
-  else
-    std::cout << text.str() << (failures.empty() ? "all evaluators passed\n" : "");
+  // A failing gate is one line on stderr naming what failed and by how much (exit 1), with
+  // nothing on stdout: the report is the answer only when the gate passed.
   if (!failures.empty()) {
     std::string joined;
     for (const auto& f : failures) joined += (joined.empty() ? "" : "; ") + f;
     throw std::runtime_error("validation failed: " + joined);
   }
+  if (options.json)
+    std::cout << document.dump(2) << "\n";
+  else
+    std::cout << text.str() << "all evaluators passed\n";
 }
 
 }  // namespace

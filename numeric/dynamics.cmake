@@ -2,6 +2,7 @@
 # (witness functions), dividing lines, the hybrid simulator, limit cycles.
 target_sources(backlash_numeric PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/src/first_crossing.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/scales.cpp             # what double precision can compute, checked first
   ${CMAKE_CURRENT_LIST_DIR}/src/segment_dynamics.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/gap_events.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/linear_flight.cpp

@@ -13,7 +13,7 @@ required_packages=(
   gnuplot-nox librsvg2-bin
   libceres-dev libmatio-dev
   texlive-latex-base texlive-latex-recommended texlive-fonts-recommended poppler-utils
-  python3-sympy python3-scipy python3-numpy python3-pytest pybind11-dev
+  python3-sympy python3-scipy python3-numpy python3-pytest python3-dev pybind11-dev
 )
 
 missing_packages=()

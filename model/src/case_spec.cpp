@@ -1,4 +1,4 @@
-// case_spec.cpp — strict, exact loader for backlash case files (DESIGN.md §3).
+// case_spec.cpp — strict, exact loader for backlash case files (docs/design.md, "Case files").
 //
 // Numbers never pass through a double: a TOML float such as `0.3` is read back
 // from the file text (the node's source position) and parsed as the exact
@@ -8,6 +8,7 @@
 // shorter forms: a file that cannot be read ("FILE: problem") and an unknown
 // case id that is not a file either ("unknown case 'IX': ...", no FILE).
 #include "backlash/model/case_spec.hpp"
+#include "backlash/model/data_dir.hpp"
 
 #include <toml++/toml.h>
 
@@ -500,7 +501,24 @@ class CaseFileReader {
     fail(line_of(node, 1), "measured_at", "expected \"motor\" or \"load\", got \"" + text->get() + "\"");
   }
 
+  /// Every number is held to magnitudes double precision computes with room to spare: its
+  /// square, its products with the others and their ratios stay finite and normal.  Beyond
+  /// 1e±100 the numeric part would overflow or flush to zero ("floating point overflow"
+  /// without a line, 1e-400 silently read as 0), so such a number is refused here, at its line.
   ExactNumber read_number(const toml::node& node, const std::string& key) const {
+    ExactNumber number = read_number_unchecked(node, key);
+    static const Rational largest = boost::multiprecision::pow(boost::multiprecision::cpp_int(10), 100);
+    static const Rational smallest = 1 / largest;
+    const Rational magnitude = abs(number.value);
+    if (magnitude != 0 && (magnitude > largest || magnitude < smallest))
+      fail(line_of(node, 1), key,
+           "magnitude out of range (got " + number.as_written +
+               "; a number other than 0 must lie between 1e-100 and 1e100 in size, where double precision "
+               "computes its products and ratios)");
+    return number;
+  }
+
+  ExactNumber read_number_unchecked(const toml::node& node, const std::string& key) const {
     const long line = line_of(node, 1);
     if (const auto* integer = node.as_integer()) {
       return {Rational(integer->get()), std::to_string(integer->get())};
@@ -583,8 +601,9 @@ CaseFileError::CaseFileError(std::filesystem::path file, long line, std::string 
       line_(line),
       key_(std::move(key)) {}
 
-CaseSpec load_case_file(const std::filesystem::path& file) {
-  const std::string contents = read_whole_file(file);
+CaseSpec load_case_file(const std::filesystem::path& file) { return parse_case(read_whole_file(file), file); }
+
+CaseSpec parse_case(const std::string& contents, const std::filesystem::path& file) {
   toml::table root;
   try {
     root = toml::parse(std::string_view(contents), std::string_view(file.string()));
@@ -609,7 +628,7 @@ std::filesystem::path thesis_cases_dir() {
   if (const char* from_environment = std::getenv("BACKLASH_CASES_DIR");
       from_environment != nullptr && *from_environment != '\0')
     return std::filesystem::path(from_environment);
-  return std::filesystem::path(BACKLASH_SOURCE_CASES_DIR);
+  return data_dir() / "cases";
 }
 
 CaseSpec load_case(const std::string& case_or_path) {

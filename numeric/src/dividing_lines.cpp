@@ -62,11 +62,20 @@ std::optional<double> return_search_start(const ValidatedEvaluator& evaluator, d
 
 }  // namespace
 
+namespace {
+DividingLinePoint point_by_profile(const ValidatedEvaluator& evaluator, double v0, const TraceOptions& options);
+/// Above this |θ̇m0| the flight's angles are so large against its gap that the direct search's
+/// noise floor (1e-10 of the position scale) no longer separates a departure from rounding:
+/// the unit profile, exact by linearity (gap = θ̇m0·f(t)), answers instead.
+constexpr double direct_search_velocity_limit = 1e3;
+}  // namespace
+
 DividingLinePoint dividing_line_point(const ValidatedEvaluator& evaluator, double v0, const TraceOptions& options) {
   const Parameters& p = evaluator.parameters();
   DividingLinePoint point;
   point.dtheta_m0 = v0;
   if (v0 == 0 || p.backlash <= 0) return point;
+  if (std::fabs(v0) > direct_search_velocity_limit) return point_by_profile(evaluator, v0, options);
   const LinearWitness gap = gap_witness(evaluator, v0, 0);
   const double scale = std::max({1.0, std::fabs(p.theta_R), std::fabs(evaluator.cot_phi() * v0)});
   const auto event = detail::first_gap_event(free_mode_segment(p), gap.state, gap.value, std::copysign(p.backlash, v0),
@@ -113,6 +122,11 @@ UnitGapProfile unit_gap_profile(const ValidatedEvaluator& evaluator, double hori
     profile.knots.push_back(t);
     profile.values.push_back(t == profile.end && back ? 0.0 : evaluator.free_state(t, unit).gap);
   };
+  // The separation point itself: f(0) = 0, and f is monotone on (0, t0] (its first non-vanishing
+  // derivative keeps its sign there), so a level below f(t0) — a large θ̇m0, whose gap reaches
+  // the face before the departure time — is found on [0, t0] instead of being missed.
+  profile.knots.push_back(0.0);
+  profile.values.push_back(0.0);
   add(*t0);
   double t = *t0;
   while (t < profile.end) {
@@ -131,7 +145,7 @@ std::optional<Crossing> first_level_crossing(const ValidatedEvaluator& evaluator
   for (size_t i = 0; i + 1 < profile.knots.size(); ++i) {
     const double a = profile.knots[i], b = profile.knots[i + 1];
     const double fa = profile.values[i] - level, fb = profile.values[i + 1] - level;
-    if (fa == 0) return Crossing{a, true, 0};  // touches the level at a maximum: grazing
+    if (fa == 0 && i > 0) return Crossing{a, true, 0};  // touches the level at a maximum: grazing
     if ((fa > 0) == (fb > 0) && fb != 0) continue;
     if (fb == 0) return Crossing{b, i + 2 < profile.knots.size(), 0};
     boost::uintmax_t iterations = 200;
@@ -160,6 +174,10 @@ DividingLinePoint point_from_profile(const ValidatedEvaluator& evaluator, const 
   }
   fill_impact_states(evaluator, point);
   return point;
+}
+
+DividingLinePoint point_by_profile(const ValidatedEvaluator& evaluator, double v0, const TraceOptions& options) {
+  return point_from_profile(evaluator, unit_gap_profile(evaluator, horizon_of(evaluator.parameters(), options)), v0);
 }
 
 }  // namespace

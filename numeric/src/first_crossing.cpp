@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace backlash::numeric {
@@ -14,10 +15,25 @@ struct Sample {
   double t, w, w1, w2, rate_norm;  // w and its first two derivatives, ‖x'(t)‖∞
 };
 
+// The logarithmic norm μ∞(A) = max_i (a_ii + Σ_{j≠i} |a_ij|): ‖e^{At}‖∞ ≤ e^{μ∞(A) t} for t ≥ 0
+// (Dahlquist).  It is never larger than ‖A‖∞ and, unlike it, is not inflated by a fast decaying
+// mode (a load whose friction stops it in microseconds has a_33 = −FL/JL ≪ 0): the growth bound
+// of a stiff segment then allows intervals on the slow time scale instead of the fast one.
+double log_norm(const SmallMatrix& A) {
+  double mu = -INFINITY;
+  for (Eigen::Index i = 0; i < A.rows(); ++i) {
+    double row = A(i, i);
+    for (Eigen::Index j = 0; j < A.cols(); ++j)
+      if (j != i) row += std::fabs(A(i, j));
+    mu = std::max(mu, row);
+  }
+  return A.rows() > 0 ? mu : 0.0;
+}
+
 struct Witness {
   const LinearWitness& lw;
   SmallRow eA, eA2, eA3;
-  double eAc, eA2c, norm_A, norm_c, norm_eA2, norm_eA3;
+  double eAc, eA2c, mu_A, norm_c, norm_eA2, norm_eA3;
 
   explicit Witness(const LinearWitness& w) : lw(w) {
     eA = w.e * w.A;
@@ -25,7 +41,7 @@ struct Witness {
     eA3 = eA2 * w.A;
     eAc = eA.dot(w.c);
     eA2c = eA2.dot(w.c);
-    norm_A = w.A.cwiseAbs().rowwise().sum().maxCoeff();
+    mu_A = log_norm(w.A);
     norm_c = w.c.cwiseAbs().maxCoeff();
     norm_eA2 = eA2.cwiseAbs().sum();
     norm_eA3 = eA3.cwiseAbs().sum();
@@ -40,8 +56,11 @@ struct Witness {
     return {t, w, w1, w2, z.cwiseAbs().maxCoeff()};
   }
 
-  // sup |w'''| on [a.t, a.t + h]: w''' = eA² z and ‖z(t)‖ ≤ e^{‖A‖(t−a)} ‖z(a)‖.
-  double third_bound(const Sample& a, double h) const { return norm_eA2 * std::exp(norm_A * h) * a.rate_norm; }
+  // sup |w'''| on [a.t, a.t + h]: w''' = eA² z and ‖z(t)‖∞ ≤ e^{μ∞(A)(t−a)} ‖z(a)‖∞ (the
+  // supremum of e^{μ s} over s ∈ [0, h] is 1 when μ ≤ 0).
+  double third_bound(const Sample& a, double h) const {
+    return norm_eA2 * std::exp(std::max(0.0, mu_A) * h) * a.rate_norm;
+  }
 };
 
 bool same_sign(double x, double y) { return (x > 0 && y > 0) || (x < 0 && y < 0); }
@@ -55,18 +74,19 @@ std::optional<double> certified_departure(const LinearWitness& witness, double n
   const double second = W.eA.dot(witness.A * x0 + witness.c);           // w''(0) = eA x'(0)
   const double third = W.eA2.dot(witness.A * x0 + witness.c);           // w'''(0) = eA² x'(0)
   const double scale = std::max(std::fabs(second), 1e-300);
-  // w'' dominant: |w''(0)| > t0 sup|w'''|, sup|w'''| ≤ ‖eA²‖ e^{‖A‖t0} z0.
+  const double growth = std::max(0.0, W.mu_A);  // ‖x'(t)‖∞ ≤ e^{μ∞(A) t} z0
+  // w'' dominant: |w''(0)| > t0 sup|w'''|, sup|w'''| ≤ ‖eA²‖ e^{μ t0} z0.
   if (std::fabs(second) > 1e-12 * std::max(1.0, z0)) {
     double t0 = std::sqrt(2 * noise / scale);
     for (int attempt = 0; attempt < 60; ++attempt, t0 *= 0.5)
-      if (std::fabs(second) > t0 * W.norm_eA2 * std::exp(W.norm_A * t0) * z0) return t0;
+      if (std::fabs(second) > t0 * W.norm_eA2 * std::exp(growth * t0) * z0) return t0;
     return std::nullopt;
   }
   if (third == 0 || !std::isfinite(third)) return std::nullopt;
-  // w''' dominant (w'' = 0): |w'''(0)| > t0 sup|w''''|, sup|w''''| ≤ ‖eA³‖ e^{‖A‖t0} z0.
+  // w''' dominant (w'' = 0): |w'''(0)| > t0 sup|w''''|, sup|w''''| ≤ ‖eA³‖ e^{μ t0} z0.
   double t0 = std::cbrt(6 * noise / std::fabs(third));
   for (int attempt = 0; attempt < 60; ++attempt, t0 *= 0.5)
-    if (std::fabs(third) > t0 * W.norm_eA3 * std::exp(W.norm_A * t0) * z0) return t0;
+    if (std::fabs(third) > t0 * W.norm_eA3 * std::exp(growth * t0) * z0) return t0;
   return std::nullopt;
 }
 
@@ -80,7 +100,8 @@ std::optional<Crossing> first_crossing(const LinearWitness& witness, double t_be
   stack.push_back({W.at(t_begin), W.at(t_end)});
   while (!stack.empty()) {
     if (++examined > options.max_intervals)
-      throw std::runtime_error("first_crossing: interval budget exhausted (pathological witness)");
+      throw SearchBudgetExhausted("the certified event search exhausted its budget of " +
+                                  std::to_string(options.max_intervals) + " intervals");
     auto [a, b] = stack.back();
     stack.pop_back();
     if (!std::isfinite(a.w) || !std::isfinite(b.w)) throw std::runtime_error("first_crossing: non-finite witness");

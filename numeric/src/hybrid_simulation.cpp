@@ -2,6 +2,7 @@
 
 #include "backlash/numeric/first_crossing.hpp"
 #include "backlash/numeric/linear_flight.hpp"
+#include "backlash/numeric/scales.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
 #include "gap_events.hpp"
 
@@ -46,8 +47,14 @@ const char* to_string(SimulationStatus status) {
     case SimulationStatus::Chattering: return "chattering";
     case SimulationStatus::EventLimit: return "event_limit";
     case SimulationStatus::NonFinite: return "non_finite";
+    case SimulationStatus::Unresolved: return "unresolved";
+    case SimulationStatus::WorkLimit: return "work_limit";
   }
   return "?";
+}
+
+bool stopped_early(SimulationStatus status) {
+  return status != SimulationStatus::Completed && status != SimulationStatus::Rest;
 }
 
 double measured(const Parameters& p, const HybridState& s) {
@@ -193,14 +200,26 @@ HybridState step_start(const Parameters& p, double step) {
   return contact_state_on_face(p, step >= 0 ? -1 : +1, p.theta_R - step, 0);
 }
 
-SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options) {
+HybridState rigid_start(const Parameters& p, const HybridState& start) {
+  if (p.backlash > 0) return start;
+  const double omega = start.dtheta_m == start.dtheta_L ? start.dtheta_m
+                                                        : recombined_velocity(p, start.dtheta_m, start.dtheta_L);
+  const int face = start.face == 0 ? -1 : start.face;
+  return contact_state_on_face(p, face, measured(p, start), omega);
+}
+
+namespace {
+
+SimulationResult simulate_as_given(const ValidatedEvaluator& evaluator, const HybridState& start,
+                                   const SimulationOptions& options) {
   const Parameters& p = evaluator.parameters();
   SimulationResult result;
   TrajectoryRecorder recorder(p, options, result);
   const LinearSegment contact_segment = contact_mode_segment(p);
   const LinearSegment free_segment = free_mode_segment(p);
   const TransmittedTorque torque = transmitted_torque(p);
-  HybridState state = start;
+  const bool rigid = p.backlash <= 0;  // a rigid drive: contact for ever, no events
+  HybridState state = rigid ? rigid_start(p, start) : start;
   double t = 0;
   std::deque<double> impacts;
   long separations = 0;
@@ -223,9 +242,18 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
     result.events.push_back(e);
   };
 
+  auto stop = [&](SimulationStatus status, std::string reason) {
+    result.stop_reason = std::move(reason);
+    return finish(status);
+  };
+
+  try {
   while (t < options.t_end) {
-    if (!finite(state)) return finish(SimulationStatus::NonFinite);
-    if (static_cast<long>(result.events.size()) >= options.max_events) return finish(SimulationStatus::EventLimit);
+    if (!finite(state)) return stop(SimulationStatus::NonFinite, "the state is no longer finite");
+    if (static_cast<long>(result.events.size()) >= options.max_events)
+      return stop(SimulationStatus::EventLimit, "the event cap of " + std::to_string(options.max_events) + " events was reached");
+    if (auto problem = resolution_problem(p, motion_scale(p, state.theta_m, state.theta_L), "the motion"))
+      return stop(SimulationStatus::Unresolved, *problem);
     const double remaining = options.t_end - t;
 
     if (state.in_contact) {
@@ -269,7 +297,7 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
         // Starting on the separation line: certified departure of Tc first.
         if (auto t0 = certified_departure(w, 1e-12)) from = *t0;
       }
-      while (true) {
+      while (!rigid) {
         separation = first_crossing(w, from, remaining);
         if (!separation || !separation->grazing) break;
         from = separation->t + 1e-12 * std::max(1.0, separation->t);
@@ -362,9 +390,57 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
                event->crossing.grazing);
     impacts.push_back(t);
     while (!impacts.empty() && impacts.front() < t - options.zeno_window) impacts.pop_front();
-    if (static_cast<int>(impacts.size()) >= options.zeno_impacts) return finish(SimulationStatus::Chattering);
+    if (static_cast<int>(impacts.size()) >= options.zeno_impacts)
+      return stop(SimulationStatus::Chattering, std::to_string(options.zeno_impacts) + " impacts within " +
+                                                    std::to_string(options.zeno_window) + " s (Zeno)");
+  }
+  } catch (const SearchBudgetExhausted& budget) {
+    return stop(SimulationStatus::WorkLimit, budget.what());
   }
   return finish(SimulationStatus::Completed);
+}
+
+void shift_state(HybridState& s, double offset) {
+  s.theta_m += offset;
+  s.theta_L += offset;
+}
+
+}  // namespace
+
+// The numerics run in error coordinates (validation.hpp, in_error_coordinates): the angles are
+// shifted by −θR on the way in and by +θR on the way out, so the gap θL − θm keeps its digits
+// whatever θR is.  A generated case evaluator (θR folded in) runs as given.
+SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options) {
+  const std::optional<ValidatedEvaluator> centred = in_error_coordinates(evaluator);
+  if (!centred) return simulate_as_given(evaluator, start, options);
+  const double R = evaluator.parameters().theta_R;
+  HybridState from = start;
+  shift_state(from, -R);
+  SimulationOptions shifted = options;
+  auto shift_sample = [R](TrajectorySample& s) {
+    s.theta_o += R;
+    s.theta_m += R;
+    s.theta_L += R;
+  };
+  if (options.sample_sink)
+    shifted.sample_sink = [&options, &shift_sample](const TrajectorySample& sample) {
+      TrajectorySample moved = sample;
+      shift_sample(moved);
+      options.sample_sink(moved);
+    };
+  SimulationResult r = simulate_as_given(*centred, from, shifted);
+  for (SimulationEvent& e : r.events) {
+    e.theta_o += R;
+    shift_state(e.after, R);
+    shift_state(e.before, R);
+  }
+  shift_state(r.final_state, R);
+  r.theta_o_final += R;
+  for (TrajectorySample& s : r.samples) shift_sample(s);
+  for (double* angle : {&r.extremes.theta_o_min, &r.extremes.theta_o_max, &r.extremes.theta_m_min, &r.extremes.theta_m_max,
+                        &r.extremes.theta_L_min, &r.extremes.theta_L_max})
+    *angle += R;  // ±infinity (nothing tracked) stays
+  return r;
 }
 
 SimulationResult simulate_step(const ValidatedEvaluator& evaluator, double step, const SimulationOptions& options) {

@@ -2,11 +2,13 @@
 
 #include "backlash/numeric/first_crossing.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
+#include "backlash/numeric/sweep.hpp"
 
 #include <boost/math/tools/roots.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace backlash::numeric {
 
@@ -20,6 +22,12 @@ HybridState separation_state(const ValidatedEvaluator& evaluator, double v) {
 double horizon(const Parameters& p) { return std::max(100.0, 60 * slowest_time_scale(p)); }
 
 }  // namespace
+
+double limit_cycle_velocity_unit(const Parameters& p) {
+  // The model is homogeneous: scaling the backlash scales every cycle, and time scales with
+  // √(J/K).  θR plays no part (it only shifts the angles).
+  return p.backlash / 0.3 * std::sqrt(p.K / (p.Jm + p.JL));
+}
 
 HalfCycle half_cycle(const ValidatedEvaluator& evaluator, double v, bool track_extremes) {
   const Parameters& p = evaluator.parameters();
@@ -100,31 +108,40 @@ std::optional<SecantResult> secant_fixed_point(const ValidatedEvaluator& evaluat
 }  // namespace
 
 LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycleOptions& options) {
+  // In error coordinates (θR = 0): nothing depends on θR, and the gap keeps its digits; the
+  // cycle's angles are shifted back at the end.
+  if (const std::optional<ValidatedEvaluator> centred = in_error_coordinates(evaluator)) {
+    LimitCycle cycle = find_limit_cycle(*centred, options);
+    shift_angles(cycle, evaluator.parameters().theta_R);
+    return cycle;
+  }
   const Parameters& p = evaluator.parameters();
   LimitCycle cycle;
   if (p.backlash <= 0) {
-    cycle.reason = "no backlash";
+    cycle.reason = "no backlash: a rigid drive never separates, so there is no cycle";
     return cycle;
   }
   std::vector<double> roots;
-  double secant_slope = std::nan("");
   if (options.guess > 0)
-    if (auto r = secant_fixed_point(evaluator, options.guess)) {
-      roots.push_back(r->v);
-      secant_slope = r->slope;
-    }
+    if (auto r = secant_fixed_point(evaluator, options.guess)) roots.push_back(r->v);
   std::string last_failure;
-  bool any_valid = !roots.empty();
+  int valid = 0, growing = 0, decaying = 0;
+  double v_lowest = 0, v_highest = 0;
   if (roots.empty()) {
     // h(v) = g(v) − v on a logarithmic grid; brackets where it changes sign between valid points.
-    const double scale = std::max(1.0, std::fabs(p.theta_R));
+    const double scale = limit_cycle_velocity_unit(p);
     std::vector<std::pair<double, double>> samples;
     for (int i = 0; i < options.grid; ++i) {
       const double v = scale * options.v_min * std::pow(options.v_max / options.v_min, i / double(options.grid - 1));
       const HalfCycle hc = half_cycle(evaluator, v);
       samples.push_back({v, hc.valid ? hc.v_out - v : std::nan("")});
       if (!hc.valid) last_failure = hc.outcome;
-      any_valid = any_valid || hc.valid;
+      if (hc.valid) {
+        if (valid++ == 0) v_lowest = v;
+        v_highest = v;
+        if (hc.v_out > v) ++growing;
+        if (hc.v_out < v) ++decaying;
+      }
     }
     for (size_t i = 1; i < samples.size(); ++i) {
       const auto [v0, h0] = samples[i - 1];
@@ -137,19 +154,37 @@ LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycl
     }
   }
   if (roots.empty()) {
-    cycle.reason = any_valid ? "the half-cycle map has no fixed point: every separation velocity decays (g(v) < v)"
-                             : "no half cycle returns to the separation line (" + last_failure + ")";
-    if (p.measured_at == model::MeasuredAt::Motor)
+    // The reason is what the samples showed, nothing more.
+    char range[160];
+    std::snprintf(range, sizeof range, "%d of %d sampled separation velocities in [%.3g, %.3g]", valid, options.grid,
+                  v_lowest, v_highest);
+    if (valid == 0) {
+      cycle.reason = "no half cycle returns to the separation line (" + last_failure + ")";
+    } else if (growing == valid) {
+      cycle.status = "divergent";
+      cycle.reason = std::string("divergent: the separation velocity grows every half cycle (g(v) > v at ") + range +
+                     "), so the oscillation grows instead of settling on a cycle";
+    } else if (decaying == valid) {
+      cycle.reason = std::string("the half-cycle map has no fixed point: the separation velocity decays every half cycle "
+                                 "(g(v) < v at ") + range + ")";
+    } else {
+      cycle.reason = std::string("the half-cycle map has no fixed point between returning half cycles (g(v) − v changes "
+                                 "sign only across velocities whose half cycle does not return: ") + last_failure + "; " +
+                     range + " return)";
+    }
+    if (p.measured_at == model::MeasuredAt::Motor && decaying == valid && valid > 0)
       cycle.reason += "; the backlash is outside the loop, so the system settles with a steady-state error";
     return cycle;
   }
   // g'(v) by central differences (g is smooth away from grazing); the stable cycle (|g'| < 1) is "the" cycle.
+  // Always at the root itself, never from the path that found it (a sweep's secant steps): the
+  // multiplier must not depend on where the search started.
   auto derivative = [&](double v) {
     const double h = 1e-6 * v;
     return (half_cycle(evaluator, v + h).v_out - half_cycle(evaluator, v - h).v_out) / (2 * h);
   };
   double chosen = roots.front();
-  double chosen_derivative = std::isnan(secant_slope) ? derivative(chosen) : secant_slope + 1;  // g' = h' + 1
+  double chosen_derivative = derivative(chosen);
   for (double r : roots) {
     if (r == chosen) continue;
     const double d = derivative(r);
@@ -164,6 +199,15 @@ LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycl
 
   // The half cycle at v*, with its exact extremes; the other half is its mirror image about θR.
   const HalfCycle half = half_cycle(evaluator, chosen, true);
+  if (!half.valid || !(half.duration > 0)) {
+    // The root lies where the half cycle does not return (g jumps there, e.g. across a grazing
+    // or a same-face separation): no cycle, never one with period 0.  (Found by the soak test.)
+    LimitCycle none;
+    none.reason = "the half-cycle map changes sign at v = " + std::to_string(chosen) +
+                  " only across a discontinuity: the half cycle there does not return to the separation line (" +
+                  (half.valid ? std::string("it returns at once") : half.outcome) + ")";
+    return none;
+  }
   cycle.period = 2 * half.duration;
   cycle.bounced = half.bounced;
   const Extremes& x = half.extremes;

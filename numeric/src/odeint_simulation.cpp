@@ -2,6 +2,8 @@
 // The only translation unit of the simulator that includes odeint (slow to compile).
 #include "backlash/numeric/odeint_simulation.hpp"
 
+#include "backlash/numeric/scales.hpp"
+
 #include <boost/math/tools/roots.hpp>
 #include <boost/numeric/odeint.hpp>
 
@@ -24,7 +26,7 @@ namespace {
 using FreeVector = std::array<double, 4>;     // p = θm − θm0, θ̇m, S·Δ, S·Δ̇ (Δ = gap change since the start)
 using ContactVector = std::array<double, 2>;  // e = θo − θR, θ̇o
 
-// The mode ODEs, written out here from DESIGN.md §1 (independently of segment_dynamics).
+// The mode ODEs, written out here from docs/physics.md (independently of segment_dynamics).
 //
 // Free mode in start-relative coordinates: the motor's displacement p = θm − θm0 and the gap
 // change Δ = (θL − θm) − (θL0 − θm0), scaled by S.  The gap is then integrated directly (no
@@ -201,7 +203,8 @@ SimulationResult simulate_with_odeint(const Parameters& p, const HybridState& st
     return std::max(1, static_cast<int>(std::ceil((tb - ta) / spacing * (1 - 1e-12))));
   };
   const bool at_motor = p.measured_at == model::MeasuredAt::Motor;
-  HybridState state = start;
+  const bool rigid = p.backlash <= 0;  // b = 0: a rigid drive, contact for ever (docs/physics.md)
+  HybridState state = rigid ? rigid_start(p, start) : start;
   double t = 0;
   long separations = 0;
   std::deque<double> impacts;
@@ -240,10 +243,19 @@ SimulationResult simulate_with_odeint(const Parameters& p, const HybridState& st
     return refine_root(velocity_at, a, b, va, vb);
   };
 
+  auto stop = [&](SimulationStatus status, std::string reason) {
+    result.stop_reason = std::move(reason);
+    return finish(status);
+  };
+
   try {
     while (t < options.t_end) {
-      if (!finite(state)) return finish(SimulationStatus::NonFinite);
-      if (static_cast<long>(result.events.size()) >= options.max_events) return finish(SimulationStatus::EventLimit);
+      if (!finite(state)) return stop(SimulationStatus::NonFinite, "the state is no longer finite");
+      if (static_cast<long>(result.events.size()) >= options.max_events)
+        return stop(SimulationStatus::EventLimit,
+                    "the event cap of " + std::to_string(options.max_events) + " events was reached");
+      if (auto problem = resolution_problem(p, motion_scale(p, state.theta_m, state.theta_L), "the motion"))
+        return stop(SimulationStatus::Unresolved, *problem);
       const double remaining = options.t_end - t;
       const double t0 = t;
 
@@ -257,9 +269,9 @@ SimulationResult simulate_with_odeint(const Parameters& p, const HybridState& st
         double h_prev = hold(y0), v_prev = y0[1];
         // Starting on the separation line (Tc ≈ 0): Tc leaving toward its non-holding sign
         // separates at once; otherwise the witness is armed once it has the holding sign.
-        bool armed = true, converged = false;
+        bool armed = !rigid, converged = rigid;
         std::optional<double> separation;
-        if (std::fabs(h_prev) <= 1e-13 * std::max(1.0, std::fabs(y0[1]))) {
+        if (!rigid && std::fabs(h_prev) <= 1e-13 * std::max(1.0, std::fabs(y0[1]))) {
           if (-face * contact_torque_rate(p, y0[0], y0[1]) < 0) separation = 0.0;
           armed = false;
         }
@@ -444,14 +456,16 @@ SimulationResult simulate_with_odeint(const Parameters& p, const HybridState& st
       push_event(opposite ? EventKind::Recombination : EventKind::Recontact, !holds);
       impacts.push_back(t);
       while (!impacts.empty() && impacts.front() < t - options.zeno_window) impacts.pop_front();
-      if (static_cast<int>(impacts.size()) >= options.zeno_impacts) return finish(SimulationStatus::Chattering);
+      if (static_cast<int>(impacts.size()) >= options.zeno_impacts)
+        return stop(SimulationStatus::Chattering, std::to_string(options.zeno_impacts) + " impacts within " +
+                                                      std::to_string(options.zeno_window) + " s (Zeno)");
     }
   } catch (const NonFiniteState&) {
-    return finish(SimulationStatus::NonFinite);
+    return stop(SimulationStatus::NonFinite, "the integration produced a non-finite state");
   } catch (const odeint::step_adjustment_error&) {
-    return finish(SimulationStatus::NonFinite);
+    return stop(SimulationStatus::NonFinite, "odeint could not adjust its step");
   } catch (const odeint::no_progress_error&) {
-    return finish(SimulationStatus::NonFinite);
+    return stop(SimulationStatus::NonFinite, "odeint made no progress");
   }
   return finish(SimulationStatus::Completed);
 }

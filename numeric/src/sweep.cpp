@@ -3,7 +3,13 @@
 #include "backlash/numeric/effects_limit_cycle.hpp"
 #include "backlash/numeric/validated_family.hpp"
 
+#include "backlash/numeric/scales.hpp"
+
+#include <algorithm>
 #include <atomic>
+#include <condition_variable>
+#include <exception>
+#include <map>
 #include <mutex>
 #include <thread>
 
@@ -22,112 +28,228 @@ Parameters thesis_base() {
 
 }  // namespace
 
+SweepPoint figure31_point(long n, long index) {
+  const double F = 0.4;
+  const bool four = index >= n;
+  const long i = four ? index - n : index;
+  const double jl_over_jm = four ? 4.0 : 1.0;
+  const double x = n == 1 ? 0.5 : static_cast<double>(i) / static_cast<double>(n - 1);
+  Parameters p = thesis_base();
+  p.Jm = 1 / (1 + jl_over_jm);
+  p.JL = jl_over_jm / (1 + jl_over_jm);
+  p.FL = x * F;
+  p.Fm = F - p.FL;
+  return {four ? "JL=4Jm" : "JL=Jm", x, p, {}};
+}
+
 std::vector<SweepPoint> figure31_points(int n) {
   std::vector<SweepPoint> points;
-  const double F = 0.4;
-  for (const auto& [series, jl_over_jm] : {std::pair<std::string, double>{"JL=Jm", 1.0}, {"JL=4Jm", 4.0}}) {
-    for (int i = 0; i < n; ++i) {
-      const double x = n == 1 ? 0.5 : i / double(n - 1);
-      Parameters p = thesis_base();
-      p.Jm = 1 / (1 + jl_over_jm);
-      p.JL = jl_over_jm / (1 + jl_over_jm);
-      p.FL = x * F;
-      p.Fm = F - p.FL;
-      points.push_back({series, x, p, {}});
-    }
-  }
+  for (long k = 0; k < 2L * n; ++k) points.push_back(figure31_point(n, k));
   return points;
+}
+
+SweepPoint figure32_point(long n, long index) {
+  struct Distribution { const char* name; double Fm, FL; };
+  static const Distribution distributions[] = {{"FL=0 Fm=.2", 0.2, 0.0}, {"Fm=3FL F=.4", 0.3, 0.1}, {"FL=3Fm F=.4", 0.1, 0.3}};
+  const Distribution& d = distributions[index / n];
+  const long i = index % n;
+  const double x = n == 1 ? 1.0 : 0.1 + (4.0 - 0.1) * static_cast<double>(i) / static_cast<double>(n - 1);
+  Parameters p = thesis_base();
+  p.Jm = 1 / (1 + x);
+  p.JL = x / (1 + x);
+  p.Fm = d.Fm;
+  p.FL = d.FL;
+  return {d.name, x, p, {}};
 }
 
 std::vector<SweepPoint> figure32_points(int n) {
-  struct Distribution { const char* name; double Fm, FL; };
-  const Distribution distributions[] = {{"FL=0 Fm=.2", 0.2, 0.0}, {"Fm=3FL F=.4", 0.3, 0.1}, {"FL=3Fm F=.4", 0.1, 0.3}};
   std::vector<SweepPoint> points;
-  for (const Distribution& d : distributions) {
-    for (int i = 0; i < n; ++i) {
-      const double x = n == 1 ? 1.0 : 0.1 + (4.0 - 0.1) * i / double(n - 1);
-      Parameters p = thesis_base();
-      p.Jm = 1 / (1 + x);
-      p.JL = x / (1 + x);
-      p.Fm = d.Fm;
-      p.FL = d.FL;
-      points.push_back({d.name, x, p, {}});
-    }
-  }
+  for (long k = 0; k < 3L * n; ++k) points.push_back(figure32_point(n, k));
   return points;
 }
 
-std::vector<SweepRow> run_sweep(const std::vector<SweepPoint>& points, const SweepOptions& options, SweepSummary* summary) {
-  std::vector<SweepRow> rows(points.size());
+void shift_angles(LimitCycle& cycle, double offset) {
+  if (offset == 0) return;
+  cycle.theta_o_max += offset;
+  cycle.theta_o_min += offset;
+  cycle.theta_o_separation += offset;
+  cycle.theta_o_recombination += offset;
+  for (double* angle : {&cycle.section_state.theta_m, &cycle.section_state.theta_L}) *angle += offset;
+}
+
+namespace {
+
+// The warm start a block carries from point to point (continuation).
+struct Continuation {
+  double guess = 0;
+  std::optional<HybridState> warm;
+  std::string series;
+  bool first = true;
+};
+
+SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& family, Continuation& c) {
+  SweepRow row;
+  row.point = point;
+  if (c.first || point.series != c.series) c.guess = 0, c.warm.reset();
+  c.first = false;
+  c.series = point.series;
+  Parameters q = point.parameters;  // error coordinates: θR = 0
+  const double reference = q.theta_R;
+  q.theta_R = 0;
+  try {
+    if (const std::optional<std::string> problem = parameter_scale_problem(q)) {
+      row.status = "refused";
+      row.reason = *problem;
+      c.guess = 0, c.warm.reset();
+      return row;
+    }
+    const ValidatedParametricFamily::Verdict verdict = family.judge(q);
+    if (!verdict.evaluator) {
+      row.status = "unvalidated";
+      row.reason = verdict.reason;
+      c.guess = 0, c.warm.reset();
+      return row;
+    }
+    const BranchSelection b = select_branches(q);
+    row.branches = std::string(branch_name(b.contact)) + "/" + branch_name(b.free);
+    if (point.effects.any()) {
+      const EffectValidationResult gate = validate_effects(*verdict.evaluator, point.effects);
+      if (!gate.passed()) {
+        row.status = "unvalidated";
+        std::string failing;
+        for (const ModeValidation& m : gate.report().modes)
+          if (!m.passed) failing += (failing.empty() ? "" : "; ") + m.mode.describe();
+        row.reason = "effect modes failed validation against odeint: " + failing;
+        c.warm.reset();
+        return row;
+      }
+      EffectLimitCycleOptions lc;
+      lc.warm_start = c.warm;
+      row.cycle = find_limit_cycle(gate.model(), lc);
+      if (row.cycle.status == "limit_cycle") c.warm = row.cycle.section_state; else c.warm.reset();
+    } else {
+      LimitCycleOptions lc;
+      lc.guess = c.guess;
+      row.cycle = find_limit_cycle(*verdict.evaluator, lc);
+      c.guess = row.cycle.status == "limit_cycle" ? row.cycle.separation_velocity : 0;
+    }
+    shift_angles(row.cycle, reference);
+    row.status = row.cycle.status;
+    row.reason = row.cycle.reason;
+  } catch (const std::exception& e) {
+    row.status = "error";
+    row.reason = e.what();
+    c.guess = 0, c.warm.reset();
+  }
+  return row;
+}
+
+}  // namespace
+
+void run_sweep_streamed(long count, const std::function<SweepPoint(long)>& point, const SweepOptions& options,
+                        const std::function<void(const SweepRow&)>& row, SweepSummary* summary) {
+  if (count <= 0) return;
+  // The family: validated at evenly spaced samples (deterministic: before any worker starts).
   ValidatedParametricFamily family;
   {
     std::vector<Parameters> samples;
-    const size_t count = std::min<size_t>(points.size(), std::max(2, options.validation_samples));
-    for (size_t k = 0; k < count; ++k)
-      samples.push_back(points[count == 1 ? 0 : k * (points.size() - 1) / (count - 1)].parameters);
+    const long k_count = std::min<long>(count, std::max(2, options.validation_samples));
+    for (long k = 0; k < k_count; ++k) {
+      const long index = k_count == 1 ? 0 : static_cast<long>(static_cast<long double>(k) * (count - 1) / (k_count - 1));
+      Parameters q = point(index).parameters;
+      q.theta_R = 0;
+      if (!parameter_scale_problem(q)) samples.push_back(q);
+    }
     family.validate_samples(samples);
   }
+  const long block = std::max(1, options.block);
+  const long blocks = (count + block - 1) / block;
+  const long threads = std::max<long>(1, std::min<long>(options.threads, blocks));
+  const long window = 4 * threads;  // blocks computed ahead of the one being delivered
+
+  std::mutex mutex;
+  std::condition_variable changed;
+  std::map<long, std::vector<SweepRow>> finished;
+  long next_block = 0, next_delivery = 0;
+  bool stopping = false;
+  std::exception_ptr failure;
   std::atomic<long> done{0};
   std::mutex progress_mutex;
-  const int threads = std::max(1, std::min<int>(options.threads, static_cast<int>(points.size())));
-  auto work = [&](size_t begin, size_t end) {
-    double guess = 0;
-    std::optional<HybridState> warm;
-    std::string previous_series;
-    for (size_t i = begin; i < end; ++i) {
-      SweepRow& row = rows[i];
-      row.point = points[i];
-      if (row.point.series != previous_series) guess = 0, warm.reset();
-      previous_series = row.point.series;
-      try {
-        const std::optional<ValidatedEvaluator> evaluator = family.at(row.point.parameters);
-        if (!evaluator) {
-          row.status = "unvalidated";
-        } else {
-          const BranchSelection b = select_branches(row.point.parameters);
-          row.branches = std::string(branch_name(b.contact)) + "/" + branch_name(b.free);
-          if (row.point.effects.any()) {
-            const EffectValidationResult gate = validate_effects(*evaluator, row.point.effects);
-            if (!gate.passed()) {
-              row.status = "unvalidated";
-            } else {
-              EffectLimitCycleOptions lc;
-              lc.warm_start = warm;
-              row.cycle = find_limit_cycle(gate.model(), lc);
-              row.status = row.cycle.status;
-              if (row.cycle.status == "limit_cycle") warm = row.cycle.section_state; else warm.reset();
-            }
-          } else {
-            LimitCycleOptions lc;
-            lc.guess = guess;
-            row.cycle = find_limit_cycle(*evaluator, lc);
-            row.status = row.cycle.status;
-            guess = row.cycle.status == "limit_cycle" ? row.cycle.separation_velocity : 0;
+
+  auto work = [&] {
+    try {
+      while (true) {
+        long b = 0;
+        {
+          std::unique_lock<std::mutex> lock(mutex);
+          changed.wait(lock, [&] { return stopping || next_block >= blocks || next_block < next_delivery + window; });
+          if (stopping || next_block >= blocks) return;
+          b = next_block++;
+        }
+        std::vector<SweepRow> rows;
+        Continuation continuation;
+        for (long i = b * block; i < std::min(count, (b + 1) * block); ++i) {
+          rows.push_back(sweep_row(point(i), family, continuation));
+          const long finished_points = ++done;
+          if (options.progress) {
+            std::lock_guard<std::mutex> lock(progress_mutex);
+            options.progress(finished_points, count);
           }
         }
-      } catch (const std::exception& e) {
-        row.status = std::string("error: ") + e.what();
-        guess = 0;
+        std::lock_guard<std::mutex> lock(mutex);
+        finished.emplace(b, std::move(rows));
+        changed.notify_all();
       }
-      const long finished = ++done;
-      if (options.progress) {
-        std::lock_guard<std::mutex> lock(progress_mutex);
-        options.progress(finished, static_cast<long>(points.size()));
-      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (!failure) failure = std::current_exception();
+      stopping = true;
+      changed.notify_all();
     }
   };
   std::vector<std::thread> pool;
-  const size_t chunk = (points.size() + threads - 1) / threads;
-  for (int k = 0; k < threads; ++k) {
-    const size_t begin = k * chunk, end = std::min(points.size(), begin + chunk);
-    if (begin < end) pool.emplace_back(work, begin, end);
+  for (long k = 0; k < threads; ++k) pool.emplace_back(work);
+  auto stop_workers = [&] {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      stopping = true;
+      changed.notify_all();
+    }
+    for (std::thread& t : pool) t.join();
+  };
+  try {
+    while (next_delivery < blocks) {
+      std::vector<SweepRow> rows;
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        changed.wait(lock, [&] { return failure || finished.count(next_delivery) > 0; });
+        if (failure) break;
+        rows = std::move(finished.at(next_delivery));
+        finished.erase(next_delivery);
+        ++next_delivery;
+        changed.notify_all();
+      }
+      for (const SweepRow& r : rows) row(r);
+    }
+  } catch (...) {
+    stop_workers();
+    throw;
   }
-  for (std::thread& t : pool) t.join();
+  stop_workers();
+  if (failure) std::rethrow_exception(failure);
   if (summary) {
     summary->validated_samples = family.samples_validated();
     summary->failed_samples = family.samples_failed();
     summary->covered_branches = family.covered_branches();
   }
+}
+
+std::vector<SweepRow> run_sweep(const std::vector<SweepPoint>& points, const SweepOptions& options, SweepSummary* summary) {
+  std::vector<SweepRow> rows;
+  rows.reserve(points.size());
+  run_sweep_streamed(
+      static_cast<long>(points.size()), [&points](long i) { return points[static_cast<std::size_t>(i)]; }, options,
+      [&rows](const SweepRow& r) { rows.push_back(r); }, summary);
   return rows;
 }
 

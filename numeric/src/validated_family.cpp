@@ -26,20 +26,41 @@ bool ValidatedParametricFamily::validate_samples(const std::vector<Parameters>& 
 
 std::optional<ValidatedEvaluator> ValidatedParametricFamily::at(const Parameters& p) {
   const BranchSelection b = select_branches(p);
-  auto covered = [&] {
+  bool tainted = false;
+  {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (failed_.count(b.contact) || failed_.count(b.free)) return std::optional<bool>(false);
-    if (passed_.count(b.contact) && passed_.count(b.free)) return std::optional<bool>(true);
-    return std::optional<bool>();
-  };
-  std::optional<bool> state = covered();
-  if (!state) {
-    validate_one(p);
-    state = covered();
+    tainted = failed_.count(b.contact) || failed_.count(b.free);
+    if (!tainted && passed_.count(b.contact) && passed_.count(b.free))
+      return ValidatedEvaluator(parametric_evaluator(p), passed_.at(b.free));
   }
-  if (!state || !*state) return std::nullopt;
+  if (tainted) {  // a sample of this branch failed: this point is judged on its own merit
+    const EvaluatorPtr evaluator = parametric_evaluator(p);
+    ValidationResult r = validate(evaluator, options_);
+    if (!r.passed()) return std::nullopt;
+    return ValidatedEvaluator(evaluator, r.report());
+  }
+  if (!validate_one(p)) return std::nullopt;  // a pass covers the branches for later calls
   std::lock_guard<std::mutex> lock(mutex_);
   return ValidatedEvaluator(parametric_evaluator(p), passed_.at(b.free));
+}
+
+ValidatedParametricFamily::Verdict ValidatedParametricFamily::judge(const Parameters& p) const {
+  const BranchSelection b = select_branches(p);
+  Verdict verdict;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const bool tainted = failed_.count(b.contact) || failed_.count(b.free);
+    if (!tainted && passed_.count(b.contact) && passed_.count(b.free)) {
+      verdict.evaluator = ValidatedEvaluator(parametric_evaluator(p), passed_.at(b.free));
+      return verdict;
+    }
+  }
+  verdict.itself = true;
+  const EvaluatorPtr evaluator = parametric_evaluator(p);
+  const ValidationResult r = validate(evaluator, options_);
+  if (r.passed()) verdict.evaluator = ValidatedEvaluator(evaluator, r.report());
+  else verdict.reason = "failed validation against odeint: " + r.report().failures();
+  return verdict;
 }
 
 long ValidatedParametricFamily::samples_validated() const {

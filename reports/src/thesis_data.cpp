@@ -1,5 +1,7 @@
 #include "backlash/reports/thesis_data.hpp"
 
+#include "backlash/model/data_dir.hpp"
+
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -12,7 +14,8 @@ namespace backlash::reports {
 namespace fs = std::filesystem;
 
 DataPaths default_data_paths() {
-  return {BACKLASH_ERRATA_SOURCE_DIR, BACKLASH_REPORTS_DATA_DIR, BACKLASH_DIVIDING_LINE_TABLES};
+  const fs::path share = model::data_dir();
+  return {share / "errata", share / "data", share / "data" / "thesis_dividing_line_tables.toml"};
 }
 
 namespace {

@@ -1,4 +1,4 @@
-// The command-line contracts of DESIGN.md §3: JSON keys others script against,
+// The command-line contracts of docs/design.md: JSON keys others script against,
 // one-line errors with a non-zero exit for bad input, and no output written
 // when a command fails.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// exam_measured_csv — the project's CSV of measured data (DESIGN.md §3), known answers.
+// exam_measured_csv — the project's CSV of measured data (docs/design.md, "Measured data (CSV)"), known answers.
 //
 // A valid file round-trips bit for bit; the accepted variations (BOM, CRLF,
 // any column order, trailing blank lines, spaces) read as expected; every bad

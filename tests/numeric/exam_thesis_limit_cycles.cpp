@@ -48,7 +48,7 @@ void expect_cycle(const std::string& id, const char* printed_magnitude, double s
   EXPECT_TRUE(c.stable) << "case " << id << ": multiplier " << c.multiplier;
   EXPECT_GT(c.period, 0);
   EXPECT_NEAR(c.peak_to_peak, 2 * c.amplitude, 1e-9) << "the cycle is odd-symmetric about theta_R";
-  // Section 14's "magnitude" is read as the peak-to-peak swing of the measured shaft (DESIGN.md §1).
+  // Section 14's "magnitude" is read as the peak-to-peak swing of the measured shaft (docs/physics.md).
   expect("Section14", id, "magnitude (peak-to-peak of theta_o)", c.peak_to_peak, printed_magnitude);
   expect_converges(id, step_inside);
   expect_converges(id, step_outside);

@@ -1,6 +1,6 @@
 // backlash/measurements/measured_record.hpp — the project's CSV of measured data.
 //
-// Contract (../shared/DESIGN.md §3 "Measured data (CSV)"): a header row naming
+// Contract (docs/design.md, "Measured data (CSV)"): a header row naming
 // the columns; `t` and `theta_out` (the measured shaft) required, `theta_motor`,
 // `theta_load` and `drive` optional, in any order; `t` strictly increasing; every
 // cell a finite number.  Anything else is a MeasuredDataError whose what() is

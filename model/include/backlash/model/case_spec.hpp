@@ -1,6 +1,6 @@
 // backlash/model/case_spec.hpp — a servo-with-backlash case, as exact rationals.
 //
-// A case file (TOML, schema in ../shared/DESIGN.md §3) describes the thesis's
+// A case file (TOML, schema in docs/design.md, "Case files") describes the thesis's
 // two-body system (gear ratio N = 1):
 //   contact mode  (Jm+JL)·θo'' + (Fm+FL)·θo' + K·θo = K·θR        (eqs. 6, 15, 25)
 //   free load     JL·θL'' + FL·θL' = 0                              (eq. 17)
@@ -111,11 +111,16 @@ class CaseFileError : public std::runtime_error {
 /// integers are accepted.
 CaseSpec load_case_file(const std::filesystem::path& file);
 
+/// The same strict reader on a case file's text already in memory; `file` names it in
+/// messages ("FILE:LINE: KEY: problem") and becomes the spec's source and id (its stem).
+CaseSpec parse_case(const std::string& contents, const std::filesystem::path& file);
+
 /// The eight thesis cases, in thesis order: I, II, ..., VIII.
 const std::vector<std::string>& thesis_case_ids();
 
-/// Folder holding I.toml … VIII.toml: $BACKLASH_CASES_DIR if set, else the
-/// source tree's cases/ (compiled in).
+/// Folder holding I.toml … VIII.toml: $BACKLASH_CASES_DIR if set, else data_dir()/cases
+/// (data_dir.hpp: share/backlash of the installation or of the build tree, found at run
+/// time; no path is compiled in).
 std::filesystem::path thesis_cases_dir();
 
 /// CASE = a thesis id ("V", case-insensitive) or the path of a case file.

@@ -11,7 +11,9 @@
 // solve_ivp), so the search is certified.  With z = x' (which obeys z' = A z,
 // so ‖z(t)‖∞ ≤ e^{‖A‖∞(t−a)}‖z(a)‖∞), on [a, b] (h = b − a) it bounds
 //   |w'''| = |eᵀA²z| ≤ ‖eᵀA²‖₁ e^{‖A‖h} ‖z(a)‖∞,
-// then |w''| ≤ M2 and |w'| ≤ M1 on [a, b] from the end values, and
+// (with μ∞(A), the logarithmic norm, in place of ‖A‖∞ where it is smaller: a fast decaying
+// mode does not shrink the intervals), then |w''| ≤ M2 and |w'| ≤ M1 on [a, b] from the end
+// values, and
 //   – excludes the interval when w(a), w(b) have one sign and |w(a)| + |w(b)| > h·M1;
 //   – accepts it as monotone when w'(a), w'(b) have one sign and (|w'(a)| + |w'(b)| − h·M2)/2 > 0,
 //     and then finds its single root (if w changes sign) with Boost.Math's toms748;
@@ -24,6 +26,7 @@
 
 #include <functional>
 #include <optional>
+#include <stdexcept>
 
 namespace backlash::numeric {
 
@@ -58,7 +61,15 @@ struct Crossing {
 struct CrossingOptions {
   double time_tolerance = 1e-14;  ///< toms748 stopping width, relative to t
   double min_interval = 1e-11;    ///< below this an uncertified interval is a grazing contact
-  long max_intervals = 2'000'000; ///< guard: then std::runtime_error (never a hang)
+  long max_intervals = 2'000'000; ///< guard: then SearchBudgetExhausted (never a hang)
+};
+
+/// A certified search that examined CrossingOptions::max_intervals intervals without an answer
+/// (a witness oscillating far faster than the span searched).  The simulators turn it into the
+/// status work_limit.
+class SearchBudgetExhausted : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
 };
 
 /// For a witness that starts at zero, w(0) = w'(0) = 0 (a gap leaving a face:

@@ -1,6 +1,6 @@
 // backlash/numeric/hybrid_simulation.hpp — the hybrid automaton, event by event.
 //
-// One frame throughout (DESIGN.md §1): the gap x = θL − θm is centred, the
+// One frame throughout (docs/physics.md): the gap x = θL − θm is centred, the
 // contact faces are x = ±b/2, and the measured shaft θo is continuous through
 // every event.  Modes and guards:
 //   contact on face σ (x = σ b/2)   θo from the validated closed form (eq. 25);
@@ -20,12 +20,17 @@
 // Every event time is the first zero of a certified witness (first_crossing.hpp):
 // no fixed steps, nothing skipped.  Outcomes that are not errors come back as
 // statuses: completed (t_end reached), rest, chattering (Zeno: too many impacts in
-// a vanishing time), event_limit, non_finite — never a hang or a NaN.
+// a vanishing time), event_limit, non_finite, unresolved (the motion grew so large that
+// double precision no longer resolves the backlash: scales.hpp), work_limit (a certified
+// search ran out of its interval budget) — never a hang or a NaN.
+// No backlash (b = 0) is a rigid drive (docs/physics.md): the gear transmits a torque of
+// either sign, so the bodies never separate and the motion is the contact mode alone.
 #pragma once
 
 #include "backlash/numeric/validation.hpp"
 
 #include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -62,12 +67,24 @@ struct SimulationEvent {
   bool accumulation = false;         ///< the end of a summed series of bounces (restitution)
 };
 
-enum class SimulationStatus { Completed, Rest, Chattering, EventLimit, NonFinite };
+enum class SimulationStatus { Completed, Rest, Chattering, EventLimit, NonFinite, Unresolved, WorkLimit };
 const char* to_string(SimulationStatus status);
+/// True for the statuses that end a simulation before t_end without the model having
+/// stopped by itself (chattering, event_limit, non_finite, unresolved, work_limit): the
+/// result is correct up to t_final and says nothing beyond it.
+bool stopped_early(SimulationStatus status);
+
+struct TrajectorySample {
+  double t, theta_o, dtheta_o, theta_m, dtheta_m, theta_L, dtheta_L;
+  bool in_contact;
+};
 
 struct SimulationOptions {
   double t_end = 60;
-  double sample_interval = 0;   ///< > 0: record the trajectory every sample_interval (for CSV)
+  double sample_interval = 0;   ///< > 0: record the trajectory at k·sample_interval, k = 0, 1, … (for CSV)
+  /// Set: every trajectory sample goes here, in time order, as soon as it is computed, and
+  /// SimulationResult::samples stays empty (memory does not grow with the output's length).
+  std::function<void(const TrajectorySample&)> sample_sink;
   /// Non-empty: record the trajectory at these times instead (ascending; a measured record's
   /// own grid; times before 0 give the start state, the system at rest before the step).
   std::vector<double> sample_times;
@@ -93,27 +110,26 @@ struct Extremes {
   double theta_L_min = INFINITY, theta_L_max = -INFINITY;
 };
 
-struct TrajectorySample {
-  double t, theta_o, dtheta_o, theta_m, dtheta_m, theta_L, dtheta_L;
-  bool in_contact;
-};
-
 struct SimulationResult {
   SimulationStatus status = SimulationStatus::Completed;
   std::vector<SimulationEvent> events;
   double t_final = 0;
   HybridState final_state;
   double theta_o_final = 0;
-  std::vector<TrajectorySample> samples;
+  std::vector<TrajectorySample> samples;  ///< (without a sample_sink)
   Extremes extremes;  ///< when options.track_extremes
+  std::string stop_reason;  ///< for an early stop (stopped_early): what happened, in words
 };
 
 /// The measured shaft of a state, and its velocity.
 double measured(const Parameters& p, const HybridState& s);
 double measured_velocity(const Parameters& p, const HybridState& s);
 
-/// Records the trajectory every `options.sample_interval` (for CSV output); shared by the
-/// closed-form and the odeint simulators (bookkeeping only, no dynamics).
+/// Records the trajectory at k·`options.sample_interval` (for CSV output) or at
+/// `options.sample_times`, into the result or into options.sample_sink; shared by the
+/// closed-form and the odeint simulators (bookkeeping only, no dynamics).  The times are
+/// k·interval with an integer k, never a running sum: no drift, and no stall where adding the
+/// interval no longer changes t.
 class TrajectoryRecorder {
  public:
   TrajectoryRecorder(const Parameters& p, const SimulationOptions& o, SimulationResult& r) : p_(p), o_(o), r_(r) {}
@@ -126,21 +142,22 @@ class TrajectoryRecorder {
       return;
     }
     if (o_.sample_interval <= 0) return;
-    while (next_ <= t_upto) {
-      push(next_, at(next_ - t0));
-      next_ += o_.sample_interval;
-    }
+    for (double next = static_cast<double>(k_) * o_.sample_interval; next <= t_upto;
+         next = static_cast<double>(++k_) * o_.sample_interval)
+      push(next, at(next - t0));
   }
 
  private:
   void push(double t, const HybridState& h) {
-    r_.samples.push_back({t, measured(p_, h), measured_velocity(p_, h), h.theta_m, h.dtheta_m, h.theta_L, h.dtheta_L,
-                          h.in_contact});
+    const TrajectorySample sample{t, measured(p_, h), measured_velocity(p_, h), h.theta_m, h.dtheta_m, h.theta_L,
+                                  h.dtheta_L, h.in_contact};
+    if (o_.sample_sink) o_.sample_sink(sample);
+    else r_.samples.push_back(sample);
   }
   const Parameters& p_;
   const SimulationOptions& o_;
   SimulationResult& r_;
-  double next_ = 0;
+  long long k_ = 0;
   std::size_t index_ = 0;
 };
 
@@ -150,6 +167,10 @@ HybridState state_on_face(const Parameters& p, int face, double theta_o, double 
 
 /// Start at rest, in contact on the face that drives toward θR, with θo = θR − step.
 HybridState step_start(const Parameters& p, double step);
+
+/// A start state made rigid for b = 0: in contact on its face, the two velocities merged by
+/// the impact law (eq. 24) when they differ.  Other states are returned unchanged.
+HybridState rigid_start(const Parameters& p, const HybridState& start);
 
 SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options);
 SimulationResult simulate_step(const ValidatedEvaluator& evaluator, double step, const SimulationOptions& options);

@@ -9,7 +9,7 @@
 // g(v*) = v*, bracketed on a logarithmic grid and refined with Boost.Math's
 // toms748.  The full return map is P = g∘g, so its multiplier is P'(v*) = g'(v*)²
 // (stable when < 1).  On the cycle: the amplitude max|θo − θR|, the peak-to-peak
-// swings of θo, θm and θL (one frame, DESIGN.md §1), the period and the
+// swings of θo, θm and θL (one frame, docs/physics.md), the period and the
 // separation velocity v*, and eq. 38's C at separation and just after
 // recombination.  No fixed point (cases I, II: the backlash is outside the loop)
 // is the status "none", with the reason.
@@ -42,8 +42,8 @@ double stability_constant(const Parameters& p, double theta_o, double dtheta_o);
 double stability_constant_jump(const Parameters& p);
 
 struct LimitCycle {
-  std::string status = "none";  ///< "limit_cycle" | "none"
-  std::string reason;           ///< for "none"
+  std::string status = "none";  ///< "limit_cycle" | "none" | "divergent" (g(v) > v wherever sampled)
+  std::string reason;           ///< for "none" and "divergent": what the search computed, in words
   double separation_velocity = 0;   ///< v*
   double multiplier = 0;            ///< P'(v*) = g'(v*)² of the full return map
   double half_map_derivative = 0;   ///< g'(v*)
@@ -68,12 +68,16 @@ struct LimitCycle {
 };
 
 struct LimitCycleOptions {
-  double v_min = 1e-4, v_max = 10;  ///< search range of separation velocities (×max(1, |θR|))
+  double v_min = 1e-4, v_max = 10;  ///< search range of separation velocities (× limit_cycle_velocity_unit)
   int grid = 40;                    ///< logarithmic grid points for the bracketing search
   double guess = 0;                 ///< > 0: start with secant steps from this v (continuation in sweeps),
                                     ///< falling back to the bracketing search if they do not converge
 };
 
 LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycleOptions& options = {});
+
+/// The unit of the search range: b/0.3 · √(K/J) — 1 for the thesis's cases III–VIII.  Cycles scale
+/// with the backlash and with the contact frequency, never with θR.
+double limit_cycle_velocity_unit(const Parameters& p);
 
 }  // namespace backlash::numeric

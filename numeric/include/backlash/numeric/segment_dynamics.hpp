@@ -7,7 +7,7 @@
 //     θ̈L = −FL θ̇L / JL                                                   (eq. 17)
 //   contact mode, y = (θo, θ̇o):  θ̈o = (K(θR − θo) − F θ̇o)/J, J = Jm + JL, F = Fm + FL  (eq. 25)
 //
-// Transmitted torque in contact (DESIGN.md §1): Tc = JL·θ̈o + FL·θ̇o.  Contact
+// Transmitted torque in contact (docs/physics.md): Tc = JL·θ̈o + FL·θ̇o.  Contact
 // on the face x = −b/2 holds while Tc ≥ 0, on x = +b/2 while Tc ≤ 0.
 #pragma once
 

@@ -6,11 +6,19 @@
 //   distributions (FL = 0, Fm = .2; Fm = 3 FL with F = .4; FL = 3 Fm with F = .4).
 //   Common to both (the thesis's cases III–VIII): J = Jm + JL = 1, K = 1,
 //   b = .3, θR = 1, output at the load; figure 31 uses F = .4 (cases V–VIII).
-// Points run on `threads` threads, each over a contiguous run of points so
-// each limit-cycle search starts from its neighbour's cycle (continuation);
-// every evaluator comes from a ValidatedParametricFamily (validated_family.hpp),
-// validated at `validation_samples` evenly spaced points and at the first point of
-// every further branch the sweep enters.
+// The points are cut into blocks of `block` consecutive points, fixed by the point count
+// alone; inside a block each limit-cycle search starts from its neighbour's cycle
+// (continuation), and every block starts cold.  Threads take whole blocks, so every row —
+// to the last bit — is the same for any thread count.  Rows are delivered in order as soon
+// as their block and every block before it are done (run_sweep_streamed): memory stays
+// bounded by a few blocks per thread, whatever the number of points.
+// Every evaluator comes from a ValidatedParametricFamily (validated_family.hpp), validated
+// at `validation_samples` evenly spaced points; a point whose branches were not covered by a
+// passing sample, or whose branch failed at some sample, is validated itself and judged on
+// its own merit (a refused row says why).  A point whose parameters double precision cannot
+// handle (scales.hpp) is refused with the reason, before any work.
+// The numerics run in error coordinates (θR = 0: nothing depends on θR) and the angles of
+// the cycle are shifted back.
 // A point with effects has its effect modes validated (effects_simulation.hpp) and its cycle
 // found on the full return map (effects_limit_cycle.hpp), warm-started from its neighbour's
 // crossing of the section.
@@ -35,7 +43,8 @@ struct SweepPoint {
 
 struct SweepRow {
   SweepPoint point;
-  std::string status;  ///< "limit_cycle" | "none" | "unvalidated" | "error: …"
+  std::string status;  ///< "limit_cycle" | "none" | "divergent" | "unvalidated" | "refused" | "error"
+  std::string reason;  ///< for every status but "limit_cycle": why, in words
   std::string branches;
   LimitCycle cycle;
 };
@@ -43,6 +52,7 @@ struct SweepRow {
 struct SweepOptions {
   int threads = 2;
   int validation_samples = 64;  ///< validate the parametric family at this many evenly spaced points (ends included)
+  int block = 32;               ///< points per warm-start block (the result does not depend on `threads`)
   std::function<void(long done, long total)> progress;  ///< called from worker threads (serialised)
 };
 
@@ -54,9 +64,21 @@ struct SweepSummary {
 std::vector<SweepRow> run_sweep(const std::vector<SweepPoint>& points, const SweepOptions& options,
                                 SweepSummary* summary = nullptr);
 
-/// Figure 31: `n` values of FL/F in [0, 1] for each of JL = Jm, JL = 4 Jm.
+/// The same for `count` points made on demand by `point(i)` (called from any thread), each row
+/// handed to `row(…)` in index order from the calling thread as soon as it and all before it are
+/// done.  An exception thrown by `row` stops the workers and is rethrown.
+void run_sweep_streamed(long count, const std::function<SweepPoint(long)>& point, const SweepOptions& options,
+                        const std::function<void(const SweepRow&)>& row, SweepSummary* summary = nullptr);
+
+/// Figure 31: `n` values of FL/F in [0, 1] for each of JL = Jm, JL = 4 Jm (2n points).
 std::vector<SweepPoint> figure31_points(int n);
-/// Figure 32: `n` values of JL/Jm in [0.1, 4] for each friction distribution.
+SweepPoint figure31_point(long n, long index);  ///< index < 2n, in the order of figure31_points
+/// Figure 32: `n` values of JL/Jm in [0.1, 4] for each friction distribution (3n points).
 std::vector<SweepPoint> figure32_points(int n);
+SweepPoint figure32_point(long n, long index);  ///< index < 3n, in the order of figure32_points
+
+/// The cycle's angles (θo extremes, separation and recombination angles, section state)
+/// moved by `offset`: from error coordinates to absolute ones.
+void shift_angles(LimitCycle& cycle, double offset);
 
 }  // namespace backlash::numeric

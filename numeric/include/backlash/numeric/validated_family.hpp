@@ -31,8 +31,18 @@ class ValidatedParametricFamily {
   bool validate_samples(const std::vector<Parameters>& samples);
 
   /// A validated evaluator for `p`, validating `p` itself when its branches are not covered
-  /// yet; nothing when a sample of its branch failed validation (thread-safe).
+  /// yet (a pass then covers them for later calls) or a sample of its branch failed; nothing
+  /// when `p` itself fails (thread-safe).
   std::optional<ValidatedEvaluator> at(const Parameters& p);
+
+  struct Verdict {
+    std::optional<ValidatedEvaluator> evaluator;
+    std::string reason;    ///< why refused: the failing states and their errors
+    bool itself = false;   ///< validated at this point (its branches were not covered by passing samples)
+  };
+  /// The deterministic verdict for `p`: accepted when both its branches passed at samples and
+  /// failed at none, else validated itself.  Records nothing (thread-safe).
+  Verdict judge(const Parameters& p) const;
 
   long samples_validated() const;
   long samples_failed() const;

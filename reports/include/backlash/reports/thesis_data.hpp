@@ -22,7 +22,10 @@ struct DataPaths {
   std::filesystem::path data_directory;
   std::filesystem::path dividing_line_tables;
 };
-/// The source tree's files (compiled in).
+/// The files of the data folder (model/data_dir.hpp, found at run time): errata/,
+/// data/ and data/thesis_dividing_line_tables.toml of share/backlash — in the build
+/// tree links to reports/errata, reports/data/*.toml and
+/// tests/numeric/data/thesis_dividing_line_tables.toml.
 DataPaths default_data_paths();
 
 struct Erratum {

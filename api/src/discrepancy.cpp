@@ -1,0 +1,169 @@
+// discrepancy.cpp — a model against a measured record: the step workflow or the
+// measured-drive one (chosen by the model's experiment), and records from files or arrays.
+#include "backlash/api/backlash.hpp"
+
+#include "format.hpp"
+
+#include "backlash/measurements/emps.hpp"
+
+#include <cmath>
+
+namespace backlash::api {
+
+using detail::appendf;
+
+namespace {
+
+std::string number_text(double value) {
+  std::string out;
+  appendf(out, "%g", value);
+  return out;
+}
+
+}  // namespace
+
+measurements::MeasuredRecord read_record(const std::filesystem::path& file) {
+  if (file.extension() == ".mat") return measurements::to_measured_record(measurements::read_emps(file));
+  return measurements::read_measured_csv(file);
+}
+
+measurements::MeasuredRecord make_record(std::vector<double> t, std::vector<double> theta_out,
+                                         std::optional<std::vector<double>> theta_motor,
+                                         std::optional<std::vector<double>> theta_load,
+                                         std::optional<std::vector<double>> drive, const std::string& name) {
+  measurements::MeasuredRecord record;
+  record.t = std::move(t);
+  record.theta_out = std::move(theta_out);
+  record.theta_motor = std::move(theta_motor);
+  record.theta_load = std::move(theta_load);
+  record.drive = std::move(drive);
+  record.source = name;
+  // The CSV contract, checked by its own reader: the shortest round-trip form makes the
+  // text give back every value bit for bit.
+  std::string text;
+  try {
+    text = measurements::format_measured_csv(record);
+  } catch (const measurements::MeasuredDataError& error) {
+    // The writer's check says "cannot write: ..."; for arrays nothing is written.
+    std::string problem = error.problem();
+    if (const std::string prefix = "cannot write: "; problem.rfind(prefix, 0) == 0) problem.erase(0, prefix.size());
+    throw measurements::MeasuredDataError(name, 0, error.column(), problem);
+  }
+  return measurements::parse_measured_csv(text, name);
+}
+
+discrepancy::Status Discrepancy::status() const { return step_ ? step_->status : drive_->status; }
+
+Discrepancy discrepancy(const Case& model, const measurements::MeasuredRecord& data, const DiscrepancyRequest& request) {
+  const model::CaseSpec& spec = model.spec();
+  Discrepancy out;
+  out.model_ = spec;
+  if (spec.experiment && spec.experiment->kind == model::ExperimentKind::Drive) {
+    if (request.step) throw BadInput("step", "the model's experiment is a measured drive, which has no step");
+    discrepancy::DriveOptions options;
+    if (request.cutoff) {
+      if (!(*request.cutoff > 0) || !std::isfinite(*request.cutoff))
+        throw BadInput("cutoff", "expected a frequency > 0 [Hz], got " + number_text(*request.cutoff));
+      options.cutoff = *request.cutoff;
+    }
+    if (request.window) {
+      if (!(*request.window > 0) || !std::isfinite(*request.window))
+        throw BadInput("window", "expected a duration > 0 [s], got " + number_text(*request.window));
+      options.window = *request.window;
+    }
+    out.window_ = options.window;
+    try {
+      out.drive_ = discrepancy::find_drive_discrepancy(spec, data, options,
+                                                       request.validation ? &*request.validation : nullptr);
+    } catch (const std::invalid_argument& error) {
+      throw BadInput("", error.what());
+    }
+    return out;
+  }
+  if (request.validation) throw BadInput("validation", "only for a measured-drive model ([experiment] kind = \"drive\")");
+  if (request.cutoff) throw BadInput("cutoff", "only for a measured-drive model ([experiment] kind = \"drive\")");
+  if (request.window) throw BadInput("window", "only for a measured-drive model ([experiment] kind = \"drive\")");
+  double step = 0;
+  if (request.step) {
+    step = *request.step;
+    if (!std::isfinite(step)) throw BadInput("step", "not finite, got " + number_text(step));
+    if (step == 0) throw BadInput("step", "must not be 0");
+  } else if (spec.experiment && spec.experiment->kind == model::ExperimentKind::Step) {
+    step = model::to_double(spec.experiment->step);
+  } else {
+    throw model::CaseFileError(spec.source, 1, "experiment.step",
+                               "the model has no [experiment] step and no step was given: there is nothing to compare");
+  }
+  if (request.threads < 1 || request.threads > 256)
+    throw BadInput("threads", "expected an integer from 1 to 256, got " + std::to_string(request.threads));
+  discrepancy::DiscrepancyOptions options;
+  options.threads = request.threads;
+  out.step_value_ = step;
+  try {
+    out.step_ = discrepancy::find_discrepancy(spec, data, step, options);
+  } catch (const std::invalid_argument& error) {  // a record the model cannot be compared with
+    throw BadInput(data.source.empty() ? "data" : data.source.string(), error.what());
+  }
+  return out;
+}
+
+std::string Discrepancy::json() const {
+  return step_ ? discrepancy::to_json(model_, *step_, step_value_) : discrepancy::drive_to_json(model_, *drive_);
+}
+
+std::vector<std::pair<std::string, std::string>> Discrepancy::files(const std::string& data_name,
+                                                                    const std::string& validation_name) const {
+  return step_ ? discrepancy::report_files(model_, data_name, *step_, step_value_)
+               : discrepancy::drive_report_files(model_, data_name, validation_name, *drive_);
+}
+
+std::string Discrepancy::corrected_case_file() const {
+  return step_ ? discrepancy::corrected_case_file(model_, *step_, step_value_)
+               : discrepancy::drive_corrected_case_file(model_, *drive_);
+}
+
+std::string Discrepancy::text(const std::string& data, const std::string& validation) const {
+  std::string out;
+  if (drive_) {
+    const discrepancy::DriveDiscrepancyResult& r = *drive_;
+    appendf(out, "%s against %s (measured drive): %s (cut-off %.4g Hz, %d least-squares solves, %.2f s)\n",
+            model_.id.c_str(), data.c_str(), discrepancy::to_string(r.status), r.cutoff, r.least_squares, r.seconds);
+    for (const discrepancy::Parameter& p : r.corrected_nominal.empty() ? r.nominal_fit : r.corrected_nominal)
+      appendf(out, "  %-14s  %.6g ± %.2g\n", p.name.c_str(), p.value, p.uncertainty);
+    for (const discrepancy::Candidate& c : r.effects) {
+      appendf(out, "  %-14s", c.effect.c_str());
+      for (const discrepancy::Parameter& p : c.parameters)
+        appendf(out, "  %s = %.6g ± %.2g", p.name.c_str(), p.value, p.uncertainty);
+      appendf(out, "  (ΔBIC %.1f)\n", c.delta_bic);
+    }
+    if (r.status == discrepancy::Status::Unexplained && !r.rounds.empty() && !r.rounds.front().empty())
+      appendf(out, "  best candidate (not decisive): %s, torque RMS %.4g\n", r.rounds.front().front().effect.c_str(),
+              r.rounds.front().front().rms);
+    appendf(out, "  torque RMS: %.4g before (best nominal), %.4g after (noise level %.3g)\n", r.rms_before, r.rms_after,
+            r.noise);
+    appendf(out, "  position RMS over %d windows of %.3g s: %.4g before, %.4g after\n", r.estimation.windows, window_,
+            r.estimation.position_rms_nominal, r.estimation.position_rms_corrected);
+    if (r.validation)
+      appendf(out, "  validation %s: torque RMS %.4g before, %.4g after; position RMS %.4g before, %.4g after\n",
+              validation.c_str(), r.validation->torque_rms_nominal, r.validation->torque_rms_corrected,
+              r.validation->position_rms_nominal, r.validation->position_rms_corrected);
+    return out;
+  }
+  const discrepancy::DiscrepancyResult& r = *step_;
+  appendf(out, "%s against %s: %s (noise %.3g, %d simulations, %.2f s)\n", model_.id.c_str(), data.c_str(),
+          discrepancy::to_string(r.status), r.noise, r.simulations, r.seconds);
+  for (const discrepancy::Candidate& c : r.effects) {
+    appendf(out, "  %-14s", c.effect.c_str());
+    for (const discrepancy::Parameter& p : c.parameters)
+      appendf(out, "  %s = %.6g ± %.2g", p.name.c_str(), p.value, p.uncertainty);
+    appendf(out, "  (ΔBIC %.1f)\n", c.delta_bic);
+  }
+  if (r.status == discrepancy::Status::Unexplained && !r.rounds.empty() && !r.rounds.front().empty())
+    appendf(out, "  best candidate (not decisive): %s, RMS %.3g\n", r.rounds.front().front().effect.c_str(),
+            r.rounds.front().front().rms);
+  appendf(out, "  RMS of theta_out: %.4g before, %.4g after (%.2f and %.2f noise sigmas)\n", r.rms_before, r.rms_after,
+          r.rms_before / r.noise, r.rms_after / r.noise);
+  return out;
+}
+
+}  // namespace backlash::api

@@ -1,0 +1,60 @@
+// format.hpp — printf into a std::string (the CLI's text output, byte for byte), and the
+// JSON values the writers share.
+#pragma once
+
+#include "backlash/numeric/effects.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdarg>
+#include <cstdio>
+#include <string>
+#include <type_traits>
+
+namespace backlash::api::detail {
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+inline void appendf(std::string& out, const char* format, ...) {
+  va_list arguments;
+  va_start(arguments, format);
+  va_list copy;
+  va_copy(copy, arguments);
+  const int length = std::vsnprintf(nullptr, 0, format, copy);
+  va_end(copy);
+  if (length > 0) {
+    const std::size_t start = out.size();
+    out.resize(start + static_cast<std::size_t>(length) + 1);
+    std::vsnprintf(out.data() + start, static_cast<std::size_t>(length) + 1, format, arguments);
+    out.resize(start + static_cast<std::size_t>(length));
+  }
+  va_end(arguments);
+}
+
+/// The effects as JSON: {"coulomb_load": 0.03, ...}, only those present.
+inline nlohmann::json effects_json(const numeric::Effects& e) {
+  nlohmann::json out = nlohmann::json::object();
+  if (e.coulomb_motor > 0) out["coulomb_motor"] = e.coulomb_motor;
+  if (e.coulomb_load > 0) out["coulomb_load"] = e.coulomb_load;
+  if (e.restitution != 0) out["restitution"] = e.restitution;
+  if (e.saturating()) out["saturation"] = e.saturation;
+  if (e.compliant()) out["compliance"] = {{"stiffness", e.mesh_stiffness}, {"damping", e.mesh_damping}};
+  if (e.delayed()) out["delay"] = e.delay;
+  if (e.torque_offset != 0) out["torque_offset"] = e.torque_offset;
+  return out;
+}
+
+/// A status as text, whether the numeric layer keeps it as text or as an enum with a
+/// to_string() beside it (as numeric::SimulationStatus).
+inline std::string status_text(const std::string& status) { return status; }
+template <class Status>
+  requires std::is_enum_v<Status>
+std::string status_text(Status status) {
+  return to_string(status);  // found by argument-dependent lookup in the enum's namespace
+}
+
+/// A JSON document as the CLI prints it: two-space indentation, final newline.
+inline std::string document(const nlohmann::json& value) { return value.dump(2) + "\n"; }
+
+}  // namespace backlash::api::detail

@@ -1,0 +1,284 @@
+// model.cpp — the validated model and its results: step response, dividing lines, limit
+// cycle, each written as the CLI prints it (the JSON keys are docs/design.md's contract).
+#include "backlash/api/backlash.hpp"
+
+#include "format.hpp"
+
+#include "backlash/numeric/effects_limit_cycle.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+
+namespace backlash::api {
+
+using detail::appendf;
+
+namespace {
+
+numeric::ValidationResult validated_nominal(const Case& c) {
+  numeric::ValidationResult result = numeric::validate(numeric::case_evaluator(c.spec()));
+  if (!result.passed()) {
+    std::string failing;
+    for (const numeric::StateError& s : result.report().states)
+      if (!s.passed) failing += (failing.empty() ? "" : ", ") + s.state;
+    throw numeric::ValidationFailed("case " + c.id() + ": the evaluator failed validation against odeint (" + failing +
+                                    "); refusing to use it");
+  }
+  return result;
+}
+
+numeric::EffectValidationResult validated_effects(const numeric::ValidationResult& nominal, const Case& c) {
+  numeric::EffectValidationResult effects = numeric::validate_effects(nominal.evaluator(), c.effects());
+  if (!effects.passed()) (void)effects.model();  // throws ValidationFailed, naming the failing modes
+  return effects;
+}
+
+std::string number_text(double value) {
+  std::string out;
+  appendf(out, "%g", value);
+  return out;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------- the model
+
+Model::Model(Case source)
+    : case_(std::move(source)), validation_(validated_nominal(case_)), effects_(validated_effects(validation_, case_)) {}
+
+Simulation Model::simulate(const SimulationRequest& request) const {
+  const model::CaseSpec& spec = case_.spec();
+  double step = 0;
+  if (request.step) {
+    step = *request.step;
+    if (!std::isfinite(step)) throw BadInput("step", "not finite, got " + number_text(step));
+  } else {
+    if (!spec.experiment) throw BadInput("step", "required (the case has no [experiment] step)");
+    if (spec.experiment->kind != model::ExperimentKind::Step)
+      throw BadInput("step", "required (the case's experiment is a measured drive, which needs its record: use the "
+                             "discrepancy workflow)");
+    step = model::to_double(spec.experiment->step);
+  }
+  double t_end = 60;
+  if (request.t_end) {
+    t_end = *request.t_end;
+    if (!std::isfinite(t_end) || t_end <= 0) throw BadInput("t_end", "must be > 0, got " + number_text(t_end));
+  } else if (spec.experiment && spec.experiment->t_end) {
+    t_end = model::to_double(*spec.experiment->t_end);
+  }
+  if (!std::isfinite(request.sample_interval) || request.sample_interval < 0)
+    throw BadInput("sample_interval", "must be >= 0, got " + number_text(request.sample_interval));
+  numeric::SimulationOptions options;
+  options.t_end = t_end;
+  options.sample_interval = request.sample_interval;
+  Simulation out;
+  out.case_id = case_.id();
+  out.step = step;
+  out.t_end = t_end;
+  out.parameters = evaluator().parameters();
+  out.effects = effect_model().effects();
+  out.result = numeric::simulate_effects_step(effect_model(), step, options);
+  return out;
+}
+
+Trace Model::trace(const std::vector<double>& v0) const {
+  if (v0.empty()) throw BadInput("v0", "empty list");
+  for (const double v : v0)
+    if (!std::isfinite(v)) throw BadInput("v0", "not finite, got " + number_text(v));
+  Trace out;
+  out.case_id = case_.id();
+  out.evaluator = evaluator().evaluator().name();
+  out.lines = numeric::trace_dividing_lines(evaluator(), v0);
+  return out;
+}
+
+Cycle Model::limit_cycle() const {
+  const model::CaseSpec& spec = case_.spec();
+  numeric::EffectLimitCycleOptions options;
+  if (spec.experiment && spec.experiment->kind == model::ExperimentKind::Step)
+    options.step = model::to_double(spec.experiment->step);
+  Cycle out;
+  out.case_id = case_.id();
+  out.parameters = evaluator().parameters();
+  out.effects = effect_model().effects();
+  out.cycle = numeric::find_limit_cycle(effect_model(), options);
+  return out;
+}
+
+// ---------------------------------------------------------------------- simulate
+
+std::string Simulation::json() const {
+  nlohmann::json events = nlohmann::json::array();
+  for (const numeric::SimulationEvent& e : result.events) {
+    nlohmann::json event{{"t", e.t},
+                         {"kind", numeric::to_string(e.kind)},
+                         {"theta_o", e.theta_o},
+                         {"dtheta_o", e.dtheta_o},
+                         {"theta_m", e.after.theta_m},
+                         {"theta_L", e.after.theta_L},
+                         {"bounce", e.bounce}};
+    if (e.body != numeric::Body::None) event["body"] = numeric::to_string(e.body);
+    if (e.accumulation) event["accumulation"] = true;
+    events.push_back(event);
+  }
+  const numeric::HybridState& f = result.final_state;
+  const nlohmann::json out{{"case", case_id},
+                           {"step", step},
+                           {"t_end", t_end},
+                           {"effects", detail::effects_json(effects)},
+                           {"status", numeric::to_string(result.status)},
+                           {"events", events},
+                           {"final",
+                            {{"t", result.t_final},
+                             {"theta_o", result.theta_o_final},
+                             {"error", final_error()},
+                             {"theta_m", f.theta_m},
+                             {"theta_L", f.theta_L},
+                             {"dtheta_m", f.dtheta_m},
+                             {"dtheta_L", f.dtheta_L},
+                             {"in_contact", f.in_contact},
+                             {"motor_stuck", f.motor_stuck},
+                             {"load_stuck", f.load_stuck}}}};
+  return detail::document(out);
+}
+
+std::string Simulation::csv() const {
+  std::string out = "t,theta_o,dtheta_o,theta_m,dtheta_m,theta_L,dtheta_L,mode\n";
+  for (const numeric::TrajectorySample& s : result.samples)
+    appendf(out, "%.10g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%s\n", s.t, s.theta_o, s.dtheta_o, s.theta_m, s.dtheta_m,
+            s.theta_L, s.dtheta_L, s.in_contact ? (effects.compliant() ? "mesh" : "contact") : "free");
+  return out;
+}
+
+std::string Simulation::text() const {
+  std::string out;
+  appendf(out, "%s, step %g over %g s: %s, %zu events (effects: %s)\n", case_id.c_str(), step, t_end,
+          numeric::to_string(result.status), result.events.size(), effects.describe().c_str());
+  for (const numeric::SimulationEvent& e : result.events)
+    appendf(out, "  t = %14.10f  %-13s theta_o = %12.8f  dtheta_o = %12.8f%s%s%s\n", e.t, numeric::to_string(e.kind),
+            e.theta_o, e.dtheta_o, e.bounce ? "  (bounce)" : "", e.accumulation ? "  (end of a bounce series)" : "",
+            e.body != numeric::Body::None ? (std::string("  ") + numeric::to_string(e.body)).c_str() : "");
+  appendf(out, "final: t = %g  theta_o = %.10f  theta_m = %.10f  theta_L = %.10f  error theta_o - theta_R = %.10f\n",
+          result.t_final, result.theta_o_final, result.final_state.theta_m, result.final_state.theta_L, final_error());
+  return out;
+}
+
+// ---------------------------------------------------------------------- trace
+
+namespace {
+nlohmann::json maybe(bool present, double value) { return present ? nlohmann::json(value) : nlohmann::json(nullptr); }
+}  // namespace
+
+std::string Trace::json() const {
+  nlohmann::json points = nlohmann::json::array();
+  for (const numeric::DividingLinePoint& p : lines.points) {
+    const bool ok = p.status != numeric::RecombinationStatus::NoRecombination;
+    points.push_back({{"v0", p.dtheta_m0},
+                      {"status", numeric::to_string(p.status)},
+                      {"grazing", p.grazing},
+                      {"t", maybe(ok, p.t)},
+                      {"theta_m", maybe(ok, p.theta_m)},
+                      {"dtheta_m", maybe(ok, p.dtheta_m)},
+                      {"theta_L", maybe(ok, p.theta_L)},
+                      {"dtheta_L", maybe(ok, p.dtheta_L)},
+                      {"theta_o", maybe(ok, p.theta_o)},
+                      {"dtheta_o", maybe(ok, p.dtheta_o)}});
+  }
+  const nlohmann::json out{
+      {"case", case_id},
+      {"cot_phi", lines.cot_phi},
+      {"threshold", lines.threshold ? nlohmann::json(*lines.threshold) : nlohmann::json(nullptr)},
+      {"horizon", lines.horizon},
+      {"evaluator", evaluator},
+      {"convention", "theta_m(0) = theta_L(0) = theta_R + cot_phi*v0; m, L before the impact, o after it (eq. 24)"},
+      {"points", points}};
+  return detail::document(out);
+}
+
+std::string Trace::csv() const {
+  std::string out = "v0,status,grazing,t,theta_m,dtheta_m,theta_L,dtheta_L,theta_o,dtheta_o\n";
+  for (const numeric::DividingLinePoint& p : lines.points) {
+    appendf(out, "%.17g,%s,%s", p.dtheta_m0, numeric::to_string(p.status), p.grazing ? "true" : "false");
+    if (p.status == numeric::RecombinationStatus::NoRecombination)
+      out += ",,,,,,,\n";
+    else
+      appendf(out, ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", p.t, p.theta_m, p.dtheta_m, p.theta_L, p.dtheta_L,
+              p.theta_o, p.dtheta_o);
+  }
+  return out;
+}
+
+std::string Trace::text() const {
+  std::string out;
+  appendf(out, "%s: separation line theta_o = theta_R %+.10g*dtheta_o", case_id.c_str(), lines.cot_phi);
+  if (lines.threshold) appendf(out, "; no recombination for |dtheta_m0| < %.10g", *lines.threshold);
+  appendf(out, "\n%10s %-13s %14s %12s %12s %12s %12s %12s %12s\n", "dtheta_m0", "status", "t", "theta_m", "dtheta_m",
+          "theta_L", "dtheta_L", "theta_o", "dtheta_o+");
+  for (const numeric::DividingLinePoint& p : lines.points) {
+    if (p.status == numeric::RecombinationStatus::NoRecombination) {
+      appendf(out, "%10.6g %-13s\n", p.dtheta_m0, "none");
+      continue;
+    }
+    appendf(out, "%10.6g %-13s %14.10f %12.8f %12.8f %12.8f %12.8f %12.8f %12.8f\n", p.dtheta_m0,
+            numeric::to_string(p.status), p.t, p.theta_m, p.dtheta_m, p.theta_L, p.dtheta_L, p.theta_o, p.dtheta_o);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------- limit cycle
+
+std::string Cycle::status() const { return detail::status_text(cycle.status); }
+
+std::string Cycle::json() const {
+  const bool ok = found();
+  const bool with_effects = effects.any();
+  auto value = [&](double v) { return ok && std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+  nlohmann::json out{{"case", case_id},
+                     {"status", status()},
+                     {"amplitude", value(cycle.amplitude)},
+                     {"peak_to_peak", value(cycle.peak_to_peak)},
+                     {"period", value(cycle.period)},
+                     {"separation_velocity", value(cycle.separation_velocity)},
+                     {"multiplier", value(cycle.multiplier)},
+                     {"half_map_derivative", value(cycle.half_map_derivative)},
+                     {"stable", ok && cycle.stable},
+                     {"peak_to_peak_motor", value(cycle.peak_to_peak_motor)},
+                     {"peak_to_peak_load", value(cycle.peak_to_peak_load)},
+                     {"bounce", ok && cycle.bounced},
+                     {"other_fixed_points", cycle.other_fixed_points},
+                     {"effects", detail::effects_json(effects)},
+                     {"method", cycle.method}};
+  if (with_effects) {
+    out["iterations"] = cycle.iterations;
+    out["residual"] = value(cycle.residual);
+  } else {
+    out["stability_constant"] = {{"C_separation", value(cycle.C_separation)},
+                                 {"C_recombination", value(cycle.C_recombination)},
+                                 {"contact_arc_crossings_of_theta_R", cycle.contact_arc_crossings_of_theta_R},
+                                 {"jump_factor_across_theta_R", numeric::stability_constant_jump(parameters)}};
+  }
+  if (!ok) out["reason"] = cycle.reason;
+  if (!ok && cycle.rest_error != 0) out["rest_error"] = cycle.rest_error;
+  return detail::document(out);
+}
+
+std::string Cycle::text() const {
+  std::string out;
+  if (!found()) {
+    appendf(out, "%s: no limit cycle: %s\n", case_id.c_str(), cycle.reason.c_str());
+    return out;
+  }
+  appendf(out, "%s: %s limit cycle (%s; effects: %s)\n", case_id.c_str(), cycle.stable ? "stable" : "unstable",
+          cycle.method.c_str(), effects.describe().c_str());
+  appendf(out, "  separation velocity  %.12f\n  multiplier (P')      %.9f\n  period               %.9f\n",
+          cycle.separation_velocity, cycle.multiplier, cycle.period);
+  appendf(out, "  amplitude |θo−θR|    %.9f\n  peak-to-peak θo      %.9f\n  peak-to-peak θm, θL  %.9f, %.9f\n",
+          cycle.amplitude, cycle.peak_to_peak, cycle.peak_to_peak_motor, cycle.peak_to_peak_load);
+  if (!effects.any())
+    appendf(out, "  eq. 38: C at separation %.9f, after recombination %.9f (contact arc crosses θR %d×)\n",
+            cycle.C_separation, cycle.C_recombination, cycle.contact_arc_crossings_of_theta_R);
+  return out;
+}
+
+}  // namespace backlash::api

@@ -1,0 +1,48 @@
+// backlash/numeric/scales.hpp — what double precision and the certified searches can
+// compute, decided before any work is done.
+//
+// Three checks, each with the reason in words when it fails:
+//   parameters   every parameter and every rate built from them (K/J, F/J, Fm/Jm, FL/JL,
+//                F², 4JK) is a finite, normal double, and the time scales are not further
+//                apart than `max_stiffness` (the fastest rate times the slowest time scale):
+//                beyond that an event search over one slow time scale needs more intervals
+//                than any budget (K = 1e140 with J = 1 is refused at once instead of running
+//                for minutes);
+//   resolution   a motion of size S (|θ − θR| of the angles, plus |θR| itself for absolute
+//                angles) is resolved when double precision represents the angles to a
+//                `backlash_resolution` fraction of the backlash: ε·S ≤ 1e-6·b.  Beyond it the
+//                gap θL − θm between two angles of size S is rounding noise (a step of 1e16
+//                with b = 0.3), and an answer would be invented, not computed;
+//   rigid drive  b = 0 needs no resolution: the bodies never separate.
+#pragma once
+
+#include "backlash/numeric/parametric.hpp"
+
+#include <optional>
+#include <string>
+
+namespace backlash::numeric {
+
+/// Largest stiffness (fastest rate × slowest time scale) accepted.
+inline constexpr double max_stiffness = 1e9;
+/// The fraction of the backlash to which angles must be resolved.
+inline constexpr double backlash_resolution = 1e-6;
+
+/// The fastest rate (1/s) of the contact and free modes: a + √k bounds |roots of s² + a s + k|.
+double fastest_mode_rate(const Parameters& p);
+
+/// Why double precision or the searches cannot handle these parameters, or nothing.  The
+/// message names the parameters (K, motor.J, motor.F, load.J, load.F, backlash).
+std::optional<std::string> parameter_scale_problem(const Parameters& p);
+
+/// The largest motion size S at which the backlash is still resolved (infinite for b = 0).
+double resolvable_scale(const Parameters& p);
+
+/// The size of a state's motion for the resolution rule: max(|θm − θR|, |θL − θR|) + |θR|.
+double motion_scale(const Parameters& p, double theta_m, double theta_L);
+
+/// Why a motion of size `scale` cannot be resolved, or nothing; `what` names its origin
+/// ("the step 1e16", "the velocity 1e20").
+std::optional<std::string> resolution_problem(const Parameters& p, double scale, const std::string& what);
+
+}  // namespace backlash::numeric

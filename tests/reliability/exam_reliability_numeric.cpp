@@ -1,0 +1,265 @@
+// Issue 10, the numeric side: every input answered right or refused with the reason.
+// One test per item (the item's number in the test name); each failed before its fix.
+// Budgets are work counts (horizons in units of the fastest rate, interval budgets), never
+// clocks.
+#include "backlash/model/case_spec.hpp"
+#include "backlash/numeric/dividing_lines.hpp"
+#include "backlash/numeric/evaluator.hpp"
+#include "backlash/numeric/first_crossing.hpp"
+#include "backlash/numeric/hybrid_simulation.hpp"
+#include "backlash/numeric/limit_cycle.hpp"
+#include "backlash/numeric/odeint_simulation.hpp"
+#include "backlash/numeric/scales.hpp"
+#include "backlash/numeric/sweep.hpp"
+#include "backlash/numeric/validation.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace backlash;
+using numeric::Parameters;
+using numeric::SimulationStatus;
+
+// Case V's numbers (section 10): Jm = JL = .5, Fm = .1, FL = .3, K = 1, b = .3, θR = 1, at the load.
+Parameters case_v(double theta_R = 1) {
+  Parameters p;
+  p.Jm = 0.5, p.Fm = 0.1, p.JL = 0.5, p.FL = 0.3, p.K = 1, p.theta_R = theta_R, p.backlash = 0.3;
+  p.measured_at = model::MeasuredAt::Load;
+  return p;
+}
+
+numeric::ValidationResult validated(const Parameters& p) { return numeric::validate(numeric::parametric_evaluator(p)); }
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+// 1. Undamped, measured at the load: the separation velocity grows every half cycle.
+TEST(Item01_Divergence, UndampedLoadServoIsReportedDivergentWithTheComputedReason) {
+  Parameters p = case_v();
+  p.Fm = 0, p.FL = 0;
+  const numeric::ValidationResult v = validated(p);
+  ASSERT_TRUE(v.passed()) << v.report().summary();
+  // What the half-cycle map does, computed independently: 0.62 grows.
+  const numeric::HalfCycle h = numeric::half_cycle(v.evaluator(), 0.62);
+  ASSERT_TRUE(h.valid) << h.outcome;
+  EXPECT_GT(h.v_out, 0.62) << "the separation velocity does not grow";
+  const numeric::LimitCycle c = numeric::find_limit_cycle(v.evaluator());
+  EXPECT_EQ(c.status, "divergent") << "returned " << c.status << " instead of divergent (reason: " << c.reason << ")";
+  EXPECT_TRUE(contains(c.reason, "grows")) << "returned reason '" << c.reason << "' instead of one saying it grows";
+  EXPECT_FALSE(contains(c.reason, "decays")) << "returned reason '" << c.reason << "', which was not computed";
+}
+
+// 2. θR = ±1e4: the physics does not depend on θR; everything runs in error coordinates.
+TEST(Item02_ErrorCoordinates, LargeReferenceGivesCaseVsCycleAndStepResponse) {
+  const numeric::ValidationResult base = validated(case_v(0));
+  ASSERT_TRUE(base.passed());
+  const numeric::LimitCycle c0 = numeric::find_limit_cycle(base.evaluator());
+  ASSERT_EQ(c0.status, "limit_cycle");
+  numeric::SimulationOptions o;
+  o.t_end = 60;
+  const numeric::SimulationResult r0 = numeric::simulate_step(base.evaluator(), 0.62, o);
+  for (double R : {1e4, -1e4}) {
+    const numeric::ValidationResult v = validated(case_v(R));
+    ASSERT_TRUE(v.passed()) << "theta_R = " << R << ": refused by the gate: " << v.report().failures();
+    const numeric::LimitCycle c = numeric::find_limit_cycle(v.evaluator());
+    ASSERT_EQ(c.status, "limit_cycle") << "theta_R = " << R << ": returned " << c.status << " instead of limit_cycle";
+    EXPECT_NEAR(c.peak_to_peak, c0.peak_to_peak, 1e-9) << "theta_R = " << R;
+    EXPECT_NEAR(c.period, c0.period, 1e-9) << "theta_R = " << R;
+    EXPECT_NEAR(c.theta_o_max - R, c0.theta_o_max, 1e-9) << "theta_R = " << R << ": angles not shifted back";
+    const numeric::SimulationResult r = numeric::simulate_step(v.evaluator(), 0.62, o);
+    ASSERT_EQ(r.events.size(), r0.events.size())
+        << "theta_R = " << R << ": returned " << r.events.size() << " events instead of " << r0.events.size();
+    for (std::size_t i = 0; i < r.events.size(); ++i) {
+      EXPECT_EQ(r.events[i].kind, r0.events[i].kind) << "event " << i;
+      EXPECT_NEAR(r.events[i].t, r0.events[i].t, 1e-9) << "event " << i;
+      EXPECT_NEAR(r.events[i].theta_o - R, r0.events[i].theta_o, 1e-9) << "event " << i;
+    }
+  }
+}
+
+// 3. A sweep judges each point on its own merit and says why a point is refused.
+TEST(Item03_SweepVerdicts, CaseVItselfIsValidatedInAWideGainSweep) {
+  std::vector<numeric::SweepPoint> points;
+  for (double K : {1.0, 5000.5, 1e4}) {
+    Parameters p = case_v();
+    p.K = K;
+    points.push_back({"V:K", K, p, {}});
+  }
+  numeric::SweepOptions options;
+  options.threads = 1;
+  const std::vector<numeric::SweepRow> rows = numeric::run_sweep(points, options);
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_EQ(rows[0].status, "limit_cycle") << "K = 1 (case V) returned " << rows[0].status << " instead of limit_cycle ("
+                                           << rows[0].reason << ")";
+  for (const numeric::SweepRow& r : rows)
+    if (r.status != "limit_cycle") EXPECT_FALSE(r.reason.empty()) << "K = " << r.point.x << ": " << r.status << " without a reason";
+}
+
+// 4. Where double precision cannot resolve the backlash, refuse with the reason.
+TEST(Item04_Resolution, HugeStepStopsAsUnresolvedInsteadOfInventingAGap) {
+  const numeric::ValidationResult v = validated(case_v());
+  ASSERT_TRUE(v.passed());
+  EXPECT_TRUE(numeric::resolution_problem(v.evaluator().parameters(), 1e16, "the step 1e16").has_value())
+      << "a step of 1e16 with b = 0.3 was accepted";
+  EXPECT_FALSE(numeric::resolution_problem(v.evaluator().parameters(), 10, "the step 10").has_value());
+  numeric::SimulationOptions o;
+  o.t_end = 60;
+  const numeric::SimulationResult r = numeric::simulate_step(v.evaluator(), 1e16, o);
+  EXPECT_EQ(r.status, SimulationStatus::Unresolved)
+      << "returned " << numeric::to_string(r.status) << " instead of unresolved; final gap "
+      << r.final_state.theta_L - r.final_state.theta_m;
+  EXPECT_FALSE(r.stop_reason.empty());
+}
+
+TEST(Item04_Resolution, LargeSeparationVelocityStillRecombines) {
+  const numeric::ValidationResult v = numeric::validate(numeric::case_evaluator(model::load_case("I")));
+  ASSERT_TRUE(v.passed());
+  for (double v0 : {1e9, 1e10}) {
+    const numeric::DividingLinePoint d = numeric::dividing_line_point(v.evaluator(), v0);
+    EXPECT_EQ(d.status, numeric::RecombinationStatus::Recombination)
+        << "v0 = " << v0 << " returned " << numeric::to_string(d.status) << " instead of recombination";
+    EXPECT_GT(d.t, 0);
+    EXPECT_LT(d.t, 1e-3) << "v0 = " << v0;
+  }
+}
+
+// 5. b = 0: a rigid drive, no events at all (with damping and without).
+TEST(Item05_RigidDrive, NoBacklashMeansNoEventsAndBothSimulatorsAgree) {
+  for (double F : {0.4, 0.0}) {
+    Parameters p = case_v();
+    p.backlash = 0;
+    p.Fm = F / 4, p.FL = 3 * F / 4;
+    const numeric::ValidationResult v = validated(p);
+    ASSERT_TRUE(v.passed()) << v.report().summary();
+    numeric::SimulationOptions o;
+    o.t_end = 60;
+    const numeric::SimulationResult r = numeric::simulate_step(v.evaluator(), 0.62, o);
+    EXPECT_EQ(r.events.size(), 0u) << "F = " << F << ": returned " << r.events.size() << " events instead of 0";
+    EXPECT_FALSE(numeric::stopped_early(r.status)) << numeric::to_string(r.status);
+    EXPECT_EQ(r.final_state.theta_m, r.final_state.theta_L);
+    const numeric::SimulationResult o2 = numeric::simulate_step_with_odeint(p, 0.62, o);
+    EXPECT_EQ(o2.events.size(), 0u) << "odeint, F = " << F;
+    EXPECT_NEAR(r.theta_o_final, o2.theta_o_final, 1e-8) << "F = " << F;
+  }
+}
+
+// 6. Results do not depend on the thread count, to the last bit.
+TEST(Item06_ThreadIndependence, Figure31And32RowsAreBitIdenticalForAnyThreadCount) {
+  for (const std::vector<numeric::SweepPoint>& points : {numeric::figure31_points(40), numeric::figure32_points(25)}) {
+    numeric::SweepOptions one, three;
+    one.threads = 1;
+    three.threads = 3;
+    const std::vector<numeric::SweepRow> a = numeric::run_sweep(points, one), b = numeric::run_sweep(points, three);
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      EXPECT_EQ(a[i].status, b[i].status) << i;
+      EXPECT_EQ(a[i].cycle.multiplier, b[i].cycle.multiplier)
+          << a[i].point.series << " x = " << a[i].point.x << ": 3 threads returned " << b[i].cycle.multiplier
+          << " instead of " << a[i].cycle.multiplier;
+      EXPECT_EQ(a[i].cycle.peak_to_peak, b[i].cycle.peak_to_peak) << i;
+      EXPECT_EQ(a[i].cycle.separation_velocity, b[i].cycle.separation_velocity) << i;
+    }
+  }
+}
+
+// 7. What cannot be computed is refused before any work; what can is computed in a bounded
+// number of steps (the horizon in units of the fastest rate).
+TEST(Item07_Scales, AbsurdStiffnessIsRefusedBeforeAnyWork) {
+  for (double K : {1e140, 1e250}) {
+    Parameters p = case_v();
+    p.K = K;
+    const auto problem = numeric::parameter_scale_problem(p);
+    ASSERT_TRUE(problem.has_value()) << "K = " << K << " accepted";
+    EXPECT_TRUE(contains(*problem, "K") || contains(*problem, "contact")) << *problem;
+  }
+  Parameters tiny = case_v();
+  tiny.Jm = 1e-310;  // subnormal
+  EXPECT_TRUE(numeric::parameter_scale_problem(tiny).has_value());
+}
+
+TEST(Item07_Scales, StiffButValidGainsAreValidatedWithinAWorkBudget) {
+  for (double K : {1e8, 1e12}) {
+    Parameters p = case_v();
+    p.K = K;
+    ASSERT_FALSE(numeric::parameter_scale_problem(p).has_value()) << "K = " << K << ": " << *numeric::parameter_scale_problem(p);
+    const numeric::ValidationOptions options;
+    const double fastest = numeric::fastest_mode_rate(p);
+    EXPECT_LE(numeric::contact_horizon(p, options) * fastest, options.max_rate_units * (1 + 1e-12)) << "K = " << K;
+    EXPECT_LE(numeric::free_horizon(p, options) * fastest, options.max_rate_units * (1 + 1e-12)) << "K = " << K;
+    const numeric::ValidationResult v = validated(p);
+    EXPECT_TRUE(v.passed()) << "K = " << K << ": " << v.report().failures();
+  }
+}
+
+TEST(Item07_Scales, InertiaRatioOneInAMillionIsComputedOrRefusedUpFront) {
+  Parameters p = case_v();
+  p.Jm = 1 / (1 + 1e6), p.JL = 1e6 / (1 + 1e6);  // JL/Jm = 1e6 ...
+  Parameters q = case_v();
+  q.Jm = 1e6 / (1 + 1e6), q.JL = 1 / (1 + 1e6);  // ... and 1e-6
+  for (const Parameters& x : {p, q}) {
+    if (numeric::parameter_scale_problem(x)) continue;  // refused before any work: fine
+    const double fastest = numeric::fastest_mode_rate(x);
+    EXPECT_LE(numeric::free_horizon(x) * fastest, numeric::ValidationOptions{}.max_rate_units * (1 + 1e-12));
+  }
+}
+
+TEST(Item07_Scales, ExhaustedSearchIsAStatusNotAnException) {
+  // A witness oscillating at 1e6 rad/s searched over 1e4 s with a budget of 1000 intervals.
+  numeric::LinearWitness w;
+  w.A = numeric::SmallMatrix::Zero(2, 2);
+  w.A(0, 1) = 1, w.A(1, 0) = -1e12;
+  w.c = numeric::SmallVector::Zero(2);
+  w.e = numeric::SmallRow::Zero(2);
+  w.e(0) = 1;
+  w.level = 2;  // never reached: the amplitude is 1
+  w.state = [](double t) {
+    numeric::SmallVector y(2);
+    y << std::cos(1e6 * t), -1e6 * std::sin(1e6 * t);
+    return y;
+  };
+  numeric::CrossingOptions budget;
+  budget.max_intervals = 1000;
+  EXPECT_THROW((void)numeric::first_crossing(w, 0, 1e4, budget), numeric::SearchBudgetExhausted);
+}
+
+// 8. Samples go to a sink as they are computed: memory does not grow with the output.
+TEST(Item08_Streaming, SamplesAreStreamedNotStored) {
+  const numeric::ValidationResult v = validated(case_v());
+  numeric::SimulationOptions o;
+  o.t_end = 60;
+  o.sample_interval = 1e-3;
+  long count = 0;
+  double last = -1;
+  bool ordered = true;
+  o.sample_sink = [&](const numeric::TrajectorySample& s) {
+    ordered = ordered && s.t > last;
+    last = s.t;
+    ++count;
+  };
+  const numeric::SimulationResult r = numeric::simulate_step(v.evaluator(), 0.62, o);
+  EXPECT_EQ(r.samples.size(), 0u) << "returned " << r.samples.size() << " stored samples instead of 0";
+  EXPECT_EQ(count, 60001) << "returned " << count << " samples instead of 60001";
+  EXPECT_TRUE(ordered);
+  EXPECT_EQ(last, 60.0) << "k·dt, not a running sum";
+}
+
+// 9. An early stop says so: a status, stopped_early, and the reason in words.
+TEST(Item09_EarlyStop, EventCapIsAnEarlyStopWithItsReason) {
+  const numeric::ValidationResult v = validated(case_v());
+  numeric::SimulationOptions o;
+  o.t_end = 2e5;
+  o.max_events = 40;
+  const numeric::SimulationResult r = numeric::simulate_step(v.evaluator(), 0.62, o);
+  EXPECT_EQ(r.status, SimulationStatus::EventLimit) << "returned " << numeric::to_string(r.status) << " instead of event_limit";
+  EXPECT_TRUE(numeric::stopped_early(r.status));
+  EXPECT_LT(r.t_final, o.t_end);
+  EXPECT_TRUE(contains(r.stop_reason, "40")) << r.stop_reason;
+  EXPECT_FALSE(numeric::stopped_early(SimulationStatus::Completed));
+  EXPECT_FALSE(numeric::stopped_early(SimulationStatus::Rest));
+}
+
+}  // namespace
