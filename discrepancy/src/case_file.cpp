@@ -7,7 +7,7 @@
 
 namespace backlash::discrepancy {
 
-namespace {
+namespace detail {
 
 // The shortest decimal that reads back as the same double (the loader reads decimals exactly).
 std::string decimal(double value) {
@@ -33,7 +33,11 @@ std::string exact_or(const model::Rational& original, double value) {
   return model::to_double(original) == value ? quoted(model::to_string(original)) : decimal(value);
 }
 
-}  // namespace
+}  // namespace detail
+
+using detail::decimal;
+using detail::exact_or;
+using detail::quoted;
 
 std::string corrected_case_file(const model::CaseSpec& spec, const DiscrepancyResult& result, double step) {
   std::ostringstream out;

@@ -3,6 +3,7 @@
 // record gives the same bytes.
 #include "backlash/discrepancy/measured_drive.hpp"
 
+#include "internal.hpp"
 #include "plots.hpp"
 
 #include <nlohmann/json.hpp>
@@ -15,6 +16,10 @@
 namespace backlash::discrepancy {
 
 namespace {
+
+using detail::decimal;
+using detail::exact_or;
+using detail::quoted;
 
 using detail::Band;
 using detail::Series;
@@ -72,28 +77,6 @@ nlohmann::json parameters_json(const numeric::Parameters& p) {
   return {{"motor.J", p.Jm}, {"motor.F", p.Fm}, {"load.J", p.JL}, {"load.F", p.FL}};
 }
 
-// The shortest decimal that reads back as the same double (the loader reads decimals exactly).
-std::string decimal(double value) {
-  char buffer[64];
-  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
-  std::string text(buffer, error == std::errc() ? end : buffer);
-  if (text.find_first_of(".e") == std::string::npos) text += ".0";
-  return text;
-}
-
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) continue;
-    out += c;
-  }
-  return out + "\"";
-}
-
-std::string exact_or(const model::Rational& original, double value) {
-  return model::to_double(original) == value ? quoted(model::to_string(original)) : decimal(value);
-}
 
 // The stretch of `count` windows that starts at the window with the largest error of `model`.
 std::pair<std::size_t, std::size_t> worst_windows(const std::vector<double>& t, const std::vector<double>& measured,
