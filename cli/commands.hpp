@@ -1,9 +1,12 @@
 // backlash/cli/commands.hpp — each subcommand of `backlash` registers itself.
 //
-// A command's callback throws backlash::cli::UsageError (or any
-// std::exception) on bad input; main() prints "backlash: error: <what>" on one
-// line to stderr and exits 2 (usage / bad input) or 1 (other failures).
-// A command writes nothing to stdout or to files before its input is known good.
+// A command is a thin shell over the facade (backlash/api/backlash.hpp): it reads its
+// flags (CLI11, flags.hpp), calls the facade and prints what the result writes (json(),
+// csv(), text()).  Its callback throws backlash::cli::UsageError, the facade's exceptions
+// or any std::exception; main() prints "backlash: error: <what>" on one line to stderr and
+// exits 2 (usage / bad input: UsageError, api::is_bad_input) or 1 (other failures); 3 for
+// StoppedEarly.  A command writes nothing to stdout or to files before its input is known
+// good.  A new command: its register_…_command here and one line in main.cpp.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -11,6 +14,7 @@
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace backlash::cli {
 
@@ -21,20 +25,19 @@ class UsageError : public std::runtime_error {
 };
 
 /// A computation that ended before its end time without the model having stopped by
-/// itself (numeric::stopped_early): the output printed so far is correct and complete up to
-/// `t`; main() says so on stderr in one line and exits 3.
+/// itself (api::Simulation::stopped_early): the output printed so far is correct and complete
+/// up to the stop; main() prints `message` ("stopped early at t = …") on stderr in one line
+/// and exits 3.
 class StoppedEarly : public std::runtime_error {
  public:
-  StoppedEarly(double t, const std::string& status, const std::string& reason)
-      : std::runtime_error("stopped early at t = " + number(t) + " (" + status + "): " + reason) {}
-
- private:
-  static std::string number(double t) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.10g", t);
-    return text;
-  }
+  using std::runtime_error::runtime_error;
 };
+
+/// Writes `text` to stdout as it is; a failed write is an error (exit 1).
+inline void print(std::string_view text) {
+  if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size())
+    throw std::runtime_error("cannot write the output");
+}
 
 void register_derive_command(CLI::App& app);   // cli/derive_command.cpp
 void register_report_command(CLI::App& app);   // cli/report_command.cpp

@@ -1,14 +1,10 @@
 // `backlash derive CASE [--json|--latex]` — the exact derivation of one case
 // (CASE = I…VIII or a case-file path), or of every general pole-structure
-// branch (CASE = general).
+// branch (CASE = general), through the facade (backlash/api/derive.hpp).
 #include "commands.hpp"
 
-#include "backlash/model/case_spec.hpp"
-#include "backlash/symbolic/derivation_output.hpp"
-#include "backlash/symbolic/forced_modes.hpp"
-#include "backlash/symbolic/general_derivation.hpp"
+#include "backlash/api/derive.hpp"
 
-#include <iostream>
 #include <memory>
 
 namespace backlash::cli {
@@ -23,28 +19,12 @@ struct DeriveOptions {
 
 void run_derive(const DeriveOptions& options) {
   if (options.case_name == "general") {
-    const auto branches = symbolic::derive_general_branches();
-    if (options.json) {
-      nlohmann::json all = nlohmann::json::array();
-      for (const auto& branch : branches) all.push_back(symbolic::to_json(branch));
-      std::cout << all.dump(2) << "\n";
-    } else {
-      for (const auto& branch : branches) std::cout << symbolic::to_latex(branch) << "\n";
-    }
+    const api::GeneralDerivation branches = api::derive_general();
+    print(options.json ? branches.json : branches.latex);
     return;
   }
-  const model::CaseSpec spec = model::load_case(options.case_name);
-  const symbolic::CaseDerivation derivation = symbolic::derive_case(spec);
-  if (options.json) {
-    nlohmann::json document = symbolic::to_json(derivation);
-    // The modes the effects add (constant torques, the closed motor loop, coupled free flight).
-    document["forced_modes"] = symbolic::forced_modes_json(symbolic::derive_forced_modes(derivation));
-    std::cout << document.dump(2) << "\n";
-  } else if (options.latex) {
-    std::cout << symbolic::to_latex(derivation) << symbolic::forced_modes_latex(symbolic::derive_forced_modes(derivation));
-  }
-  else
-    std::cout << symbolic::to_text(derivation);
+  const api::Derivation derivation = api::derive(api::load(options.case_name));
+  print(options.json ? derivation.json : options.latex ? derivation.latex : derivation.text);
 }
 
 }  // namespace

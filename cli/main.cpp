@@ -3,7 +3,8 @@
 // Every subcommand registers itself (cli/commands.hpp).  Errors become one line
 // on stderr, "backlash: error: <what>", and the exit code tells their kind:
 //   0  success, and --help (CLI11 prints it through app.exit)
-//   2  bad usage or bad input (CLI11 parse errors, UsageError, CaseFileError)
+//   2  bad usage or bad input (CLI11 parse errors, UsageError, and what the facade calls bad
+//      input, api::is_bad_input: its BadInput named by the flag, CaseFileError, MeasuredDataError)
 //   1  any other failure
 //   3  a simulation stopped before its end time (chattering, event cap, non-finite,
 //      unresolved, work limit): what was computed is printed, the reason is on stderr
@@ -11,14 +12,14 @@
 // errors are reported here in the one-line form with exit code 2 instead.
 #include "commands.hpp"
 
-#include "backlash/measurements/measured_record.hpp"
-#include "backlash/model/case_spec.hpp"
+#include "backlash/api/backlash.hpp"
 #include "backlash/reports/output_directory.hpp"
 
 #include <CLI/CLI.hpp>
 
 #include <exception>
 #include <iostream>
+#include <map>
 #include <string>
 
 namespace {
@@ -34,6 +35,18 @@ int report_error(std::string message, int exit_code, const char* prefix = "backl
   while (!message.empty() && message.back() == ' ') message.pop_back();
   std::cerr << prefix << message << '\n';
   return exit_code;
+}
+
+/// The facade's BadInput in the command line's words: its argument named by the flag
+/// ("t_end: must be > 0" → "--t-end: must be > 0"); an argument that is no flag (a file) as it is.
+std::string flag_message(const backlash::api::BadInput& error) {
+  static const std::map<std::string, std::string> flags{
+      {"step", "--step"},       {"t_end", "--t-end"},       {"sample_interval", "--dt"}, {"v0", "--v0"},
+      {"vary", "--vary"},       {"from", "--from"},         {"to", "--to"},              {"points", "--points"},
+      {"threads", "--threads"}, {"tolerance", "--tolerance"}, {"cutoff", "--cutoff"},    {"window", "--window"},
+      {"validation", "--validate"}, {"target", "sweep"},    {"case", "validate"}};
+  const auto flag = flags.find(error.argument());
+  return flag == flags.end() ? error.what() : flag->second + ": " + error.problem();
 }
 
 }  // namespace
@@ -64,14 +77,12 @@ int main(int argument_count, char** arguments) {
     return report_error(early.what(), exit_code_for_early_stop, "backlash: ");
   } catch (const backlash::cli::UsageError& usage_error) {
     return report_error(usage_error.what(), exit_code_for_bad_input);
-  } catch (const backlash::model::CaseFileError& case_file_error) {
-    return report_error(case_file_error.what(), exit_code_for_bad_input);
-  } catch (const backlash::measurements::MeasuredDataError& data_error) {
-    return report_error(data_error.what(), exit_code_for_bad_input);
+  } catch (const backlash::api::BadInput& bad_input) {
+    return report_error(flag_message(bad_input), exit_code_for_bad_input);
   } catch (const backlash::reports::BadInput& bad_output) {
     return report_error(bad_output.what(), exit_code_for_bad_input);
-  } catch (const std::exception& other_error) {
-    return report_error(other_error.what(), exit_code_for_failure);
+  } catch (const std::exception& error) {  // CaseFileError, MeasuredDataError: bad input too
+    return report_error(error.what(), backlash::api::is_bad_input(error) ? exit_code_for_bad_input : exit_code_for_failure);
   }
   return 0;
 }

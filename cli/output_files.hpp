@@ -22,6 +22,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace backlash::cli {
@@ -79,7 +80,7 @@ class AtomicFile {
   AtomicFile& operator=(const AtomicFile&) = delete;
 
   FILE* stream() const { return stream_; }
-  void write(const std::string& text) {
+  void write(std::string_view text) {
     if (std::fwrite(text.data(), 1, text.size(), stream_) != text.size())
       throw std::runtime_error("cannot write " + target_.string() + ": " + std::strerror(errno));
   }

@@ -29,12 +29,7 @@ void run_report(const ReportCommandOptions& options) {
   reports::ReportOptions report_options;
   report_options.out = options.out;
   report_options.pdf = !options.no_pdf;
-  reports::ReportResult result;
-  try {
-    result = reports::write_report(report_options);
-  } catch (const reports::BadInput& bad) {
-    throw UsageError(bad.what());
-  }
+  const reports::ReportResult result = reports::write_report(report_options);  // reports::BadInput: exit 2 (main.cpp)
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   char timing[32];
   std::snprintf(timing, sizeof timing, "%.2f", seconds);

@@ -14,10 +14,16 @@ using detail::appendf;
 
 namespace {
 
-std::string number_text(double value) {
-  std::string out;
-  appendf(out, "%g", value);
-  return out;
+using detail::number_text;
+
+/// The named effects, one line each: "  NAME  p = v ± u ...  (ΔBIC d)".
+void append_effects(std::string& out, const std::vector<discrepancy::Candidate>& effects) {
+  for (const discrepancy::Candidate& c : effects) {
+    appendf(out, "  %-14s", c.effect.c_str());
+    for (const discrepancy::Parameter& p : c.parameters)
+      appendf(out, "  %s = %.6g ± %.2g", p.name.c_str(), p.value, p.uncertainty);
+    appendf(out, "  (ΔBIC %.1f)\n", c.delta_bic);
+  }
 }
 
 }  // namespace
@@ -63,12 +69,12 @@ Discrepancy discrepancy(const Case& model, const measurements::MeasuredRecord& d
     discrepancy::DriveOptions options;
     if (request.cutoff) {
       if (!(*request.cutoff > 0) || !std::isfinite(*request.cutoff))
-        throw BadInput("cutoff", "expected a frequency > 0 [Hz], got " + number_text(*request.cutoff));
+        throw BadInput("cutoff", "expected a frequency > 0 [Hz], got '" + number_text(*request.cutoff) + "'");
       options.cutoff = *request.cutoff;
     }
     if (request.window) {
       if (!(*request.window > 0) || !std::isfinite(*request.window))
-        throw BadInput("window", "expected a duration > 0 [s], got " + number_text(*request.window));
+        throw BadInput("window", "expected a duration > 0 [s], got '" + number_text(*request.window) + "'");
       options.window = *request.window;
     }
     out.window_ = options.window;
@@ -130,12 +136,7 @@ std::string Discrepancy::text(const std::string& data, const std::string& valida
             model_.id.c_str(), data.c_str(), discrepancy::to_string(r.status), r.cutoff, r.least_squares, r.seconds);
     for (const discrepancy::Parameter& p : r.corrected_nominal.empty() ? r.nominal_fit : r.corrected_nominal)
       appendf(out, "  %-14s  %.6g ± %.2g\n", p.name.c_str(), p.value, p.uncertainty);
-    for (const discrepancy::Candidate& c : r.effects) {
-      appendf(out, "  %-14s", c.effect.c_str());
-      for (const discrepancy::Parameter& p : c.parameters)
-        appendf(out, "  %s = %.6g ± %.2g", p.name.c_str(), p.value, p.uncertainty);
-      appendf(out, "  (ΔBIC %.1f)\n", c.delta_bic);
-    }
+    append_effects(out, r.effects);
     if (r.status == discrepancy::Status::Unexplained && !r.rounds.empty() && !r.rounds.front().empty())
       appendf(out, "  best candidate (not decisive): %s, torque RMS %.4g\n", r.rounds.front().front().effect.c_str(),
               r.rounds.front().front().rms);
@@ -152,12 +153,7 @@ std::string Discrepancy::text(const std::string& data, const std::string& valida
   const discrepancy::DiscrepancyResult& r = *step_;
   appendf(out, "%s against %s: %s (noise %.3g, %d simulations, %.2f s)\n", model_.id.c_str(), data.c_str(),
           discrepancy::to_string(r.status), r.noise, r.simulations, r.seconds);
-  for (const discrepancy::Candidate& c : r.effects) {
-    appendf(out, "  %-14s", c.effect.c_str());
-    for (const discrepancy::Parameter& p : c.parameters)
-      appendf(out, "  %s = %.6g ± %.2g", p.name.c_str(), p.value, p.uncertainty);
-    appendf(out, "  (ΔBIC %.1f)\n", c.delta_bic);
-  }
+  append_effects(out, r.effects);
   if (r.status == discrepancy::Status::Unexplained && !r.rounds.empty() && !r.rounds.front().empty())
     appendf(out, "  best candidate (not decisive): %s, RMS %.3g\n", r.rounds.front().front().effect.c_str(),
             r.rounds.front().front().rms);

@@ -1,7 +1,8 @@
-// format.hpp — printf into a std::string (the CLI's text output, byte for byte), and the
-// JSON values the writers share.
+// format.hpp — printf into a std::string (the CLI's text output, byte for byte), the JSON
+// values the writers share, and the checks every route takes.
 #pragma once
 
+#include "backlash/model/case_spec.hpp"
 #include "backlash/numeric/effects.hpp"
 
 #include <nlohmann/json.hpp>
@@ -32,6 +33,13 @@ inline void appendf(std::string& out, const char* format, ...) {
   va_end(arguments);
 }
 
+/// A number as printf's %g writes it (the facade's messages: "got -3").
+inline std::string number_text(double value) {
+  std::string out;
+  appendf(out, "%g", value);
+  return out;
+}
+
 /// The effects as JSON: {"coulomb_load": 0.03, ...}, only those present.
 inline nlohmann::json effects_json(const numeric::Effects& e) {
   nlohmann::json out = nlohmann::json::object();
@@ -53,6 +61,11 @@ template <class Status>
 std::string status_text(Status status) {
   return to_string(status);  // found by argument-dependent lookup in the enum's namespace
 }
+
+/// Refuses, before any work, parameters whose rates double precision or the certified event
+/// searches cannot handle (numeric/scales.hpp): model::CaseFileError "FILE: cannot be
+/// computed in double precision: K, motor.J: problem" (model.cpp).
+void check_parameter_scales(const model::CaseSpec& spec);
 
 /// A JSON document as the CLI prints it: two-space indentation, final newline.
 inline std::string document(const nlohmann::json& value) { return value.dump(2) + "\n"; }

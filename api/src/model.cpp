@@ -5,6 +5,7 @@
 #include "format.hpp"
 
 #include "backlash/numeric/effects_limit_cycle.hpp"
+#include "backlash/numeric/scales.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -17,6 +18,7 @@ using detail::appendf;
 namespace {
 
 numeric::ValidationResult validated_nominal(const Case& c) {
+  detail::check_parameter_scales(c.spec());
   numeric::ValidationResult result = numeric::validate(numeric::case_evaluator(c.spec()));
   if (!result.passed()) {
     std::string failing;
@@ -34,9 +36,42 @@ numeric::EffectValidationResult validated_effects(const numeric::ValidationResul
   return effects;
 }
 
-std::string number_text(double value) {
+/// The step A: the request's, else the case's [experiment] step.
+double requested_step(const model::CaseSpec& spec, const std::optional<double>& given) {
+  if (given) {
+    if (!std::isfinite(*given)) throw BadInput("step", "not finite, got " + detail::number_text(*given));
+    return *given;
+  }
+  if (!spec.experiment) throw BadInput("step", "required (the case has no [experiment] step)");
+  if (spec.experiment->kind != model::ExperimentKind::Step)
+    throw BadInput("step", "required (the case's experiment is a measured drive, which needs its record: use the "
+                           "discrepancy workflow)");
+  return model::to_double(spec.experiment->step);
+}
+
+/// The end time: the request's, else the case's t_end, else 60 s.
+double requested_t_end(const model::CaseSpec& spec, const std::optional<double>& given) {
+  if (given) {
+    if (!std::isfinite(*given) || *given <= 0) throw BadInput("t_end", "must be > 0, got " + detail::number_text(*given));
+    return *given;
+  }
+  return spec.experiment && spec.experiment->t_end ? model::to_double(*spec.experiment->t_end) : 60.0;
+}
+
+/// `simulate --csv`'s header and rows (shared by the whole CSV and the streamed one).
+constexpr const char* csv_header = "t,theta_o,dtheta_o,theta_m,dtheta_m,theta_L,dtheta_L,mode\n";
+
+void append_sample(std::string& out, const numeric::TrajectorySample& s, const char* contact_mode) {
+  appendf(out, "%.10g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%s\n", s.t, s.theta_o, s.dtheta_o, s.theta_m, s.dtheta_m,
+          s.theta_L, s.dtheta_L, s.in_contact ? contact_mode : "free");
+}
+
+/// The CSV's last line after an early stop (nothing otherwise).
+std::string csv_end(const Simulation& run) {
   std::string out;
-  appendf(out, "%g", value);
+  if (run.stopped_early())
+    appendf(out, "# stopped early at t = %.10g: %s: %s\n", run.result.t_final, numeric::to_string(run.result.status),
+            run.result.stop_reason.c_str());
   return out;
 }
 
@@ -47,45 +82,67 @@ std::string number_text(double value) {
 Model::Model(Case source)
     : case_(std::move(source)), validation_(validated_nominal(case_)), effects_(validated_effects(validation_, case_)) {}
 
-Simulation Model::simulate(const SimulationRequest& request) const {
-  const model::CaseSpec& spec = case_.spec();
-  double step = 0;
-  if (request.step) {
-    step = *request.step;
-    if (!std::isfinite(step)) throw BadInput("step", "not finite, got " + number_text(step));
-  } else {
-    if (!spec.experiment) throw BadInput("step", "required (the case has no [experiment] step)");
-    if (spec.experiment->kind != model::ExperimentKind::Step)
-      throw BadInput("step", "required (the case's experiment is a measured drive, which needs its record: use the "
-                             "discrepancy workflow)");
-    step = model::to_double(spec.experiment->step);
-  }
-  double t_end = 60;
-  if (request.t_end) {
-    t_end = *request.t_end;
-    if (!std::isfinite(t_end) || t_end <= 0) throw BadInput("t_end", "must be > 0, got " + number_text(t_end));
-  } else if (spec.experiment && spec.experiment->t_end) {
-    t_end = model::to_double(*spec.experiment->t_end);
-  }
-  if (!std::isfinite(request.sample_interval) || request.sample_interval < 0)
-    throw BadInput("sample_interval", "must be >= 0, got " + number_text(request.sample_interval));
-  numeric::SimulationOptions options;
-  options.t_end = t_end;
-  options.sample_interval = request.sample_interval;
+namespace {
+
+/// A simulation's request checked and its options made; the result is still to be computed.
+Simulation prepared(const Model& m, const SimulationRequest& request, numeric::SimulationOptions& options) {
+  const model::CaseSpec& spec = m.source().spec();
   Simulation out;
-  out.case_id = case_.id();
-  out.step = step;
-  out.t_end = t_end;
-  out.parameters = evaluator().parameters();
-  out.effects = effect_model().effects();
-  out.result = numeric::simulate_effects_step(effect_model(), step, options);
+  out.step = requested_step(spec, request.step);
+  out.t_end = requested_t_end(spec, request.t_end);
+  if (!std::isfinite(request.sample_interval) || request.sample_interval < 0)
+    throw BadInput("sample_interval", "must be >= 0, got " + detail::number_text(request.sample_interval));
+  out.case_id = m.id();
+  out.parameters = m.evaluator().parameters();
+  out.effects = m.effect_model().effects();
+  // A step whose motion double precision cannot resolve against the backlash is refused
+  // before any work (numeric/scales.hpp): an answer there would be rounding noise.
+  const std::string what = request.step ? "the step " + detail::number_text(out.step) : "the step of the case file";
+  if (const auto problem = numeric::resolution_problem(out.parameters, std::fabs(out.step), what))
+    throw BadInput("step", *problem);
+  options.t_end = out.t_end;
+  options.sample_interval = request.sample_interval;
   return out;
+}
+
+}  // namespace
+
+Simulation Model::simulate(const SimulationRequest& request) const {
+  numeric::SimulationOptions options;
+  Simulation out = prepared(*this, request, options);
+  out.result = numeric::simulate_effects_step(effect_model(), out.step, options);
+  return out;
+}
+
+Simulation Model::simulate_csv(const SimulationRequest& request, const TextSink& csv) const {
+  if (!(request.sample_interval > 0))
+    throw BadInput("sample_interval", "must be > 0, got " + detail::number_text(request.sample_interval));
+  numeric::SimulationOptions options;
+  Simulation out = prepared(*this, request, options);
+  const char* contact_mode = out.effects.compliant() ? "mesh" : "contact";
+  csv(csv_header);
+  std::string line;
+  options.sample_sink = [&](const numeric::TrajectorySample& s) {
+    line.clear();
+    append_sample(line, s, contact_mode);
+    csv(line);
+  };
+  out.result = numeric::simulate_effects_step(effect_model(), out.step, options);
+  if (const std::string end = csv_end(out); !end.empty()) csv(end);
+  return out;
+}
+
+void detail::check_parameter_scales(const model::CaseSpec& spec) {
+  numeric::Parameters p = numeric::parameters_of(spec);
+  p.theta_R = 0;  // the numerics run in error coordinates: θR plays no part
+  if (const std::optional<std::string> problem = numeric::parameter_scale_problem(p))
+    throw model::CaseFileError(spec.source, 0, "", "cannot be computed in double precision: " + *problem);
 }
 
 Trace Model::trace(const std::vector<double>& v0) const {
   if (v0.empty()) throw BadInput("v0", "empty list");
   for (const double v : v0)
-    if (!std::isfinite(v)) throw BadInput("v0", "not finite, got " + number_text(v));
+    if (!std::isfinite(v)) throw BadInput("v0", "not finite, got " + detail::number_text(v));
   Trace out;
   out.case_id = case_.id();
   out.evaluator = evaluator().evaluator().name();
@@ -108,9 +165,21 @@ Cycle Model::limit_cycle() const {
 
 // ---------------------------------------------------------------------- simulate
 
-std::string Simulation::json() const {
-  nlohmann::json events = nlohmann::json::array();
-  for (const numeric::SimulationEvent& e : result.events) {
+bool Simulation::stopped_early() const { return numeric::stopped_early(result.status); }
+
+std::string Simulation::stop_message() const {
+  std::string out;
+  if (stopped_early())
+    appendf(out, "stopped early at t = %.10g (%s): %s", result.t_final, numeric::to_string(result.status),
+            result.stop_reason.c_str());
+  return out;
+}
+
+namespace {
+
+nlohmann::json events_json(const std::vector<numeric::SimulationEvent>& events) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const numeric::SimulationEvent& e : events) {
     nlohmann::json event{{"t", e.t},
                          {"kind", numeric::to_string(e.kind)},
                          {"theta_o", e.theta_o},
@@ -120,35 +189,41 @@ std::string Simulation::json() const {
                          {"bounce", e.bounce}};
     if (e.body != numeric::Body::None) event["body"] = numeric::to_string(e.body);
     if (e.accumulation) event["accumulation"] = true;
-    events.push_back(event);
+    out.push_back(event);
   }
+  return out;
+}
+
+}  // namespace
+
+std::string Simulation::json() const {
   const numeric::HybridState& f = result.final_state;
-  const nlohmann::json out{{"case", case_id},
-                           {"step", step},
-                           {"t_end", t_end},
-                           {"effects", detail::effects_json(effects)},
-                           {"status", numeric::to_string(result.status)},
-                           {"events", events},
-                           {"final",
-                            {{"t", result.t_final},
-                             {"theta_o", result.theta_o_final},
-                             {"error", final_error()},
-                             {"theta_m", f.theta_m},
-                             {"theta_L", f.theta_L},
-                             {"dtheta_m", f.dtheta_m},
-                             {"dtheta_L", f.dtheta_L},
-                             {"in_contact", f.in_contact},
-                             {"motor_stuck", f.motor_stuck},
-                             {"load_stuck", f.load_stuck}}}};
+  nlohmann::json out{{"case", case_id},
+                     {"step", step},
+                     {"t_end", t_end},
+                     {"effects", detail::effects_json(effects)},
+                     {"status", numeric::to_string(result.status)},
+                     {"events", events_json(result.events)},
+                     {"final",
+                      {{"t", result.t_final},
+                       {"theta_o", result.theta_o_final},
+                       {"error", final_error()},
+                       {"theta_m", f.theta_m},
+                       {"theta_L", f.theta_L},
+                       {"dtheta_m", f.dtheta_m},
+                       {"dtheta_L", f.dtheta_L},
+                       {"in_contact", f.in_contact},
+                       {"motor_stuck", f.motor_stuck},
+                       {"load_stuck", f.load_stuck}}}};
+  if (stopped_early()) out["stop_reason"] = result.stop_reason;
   return detail::document(out);
 }
 
 std::string Simulation::csv() const {
-  std::string out = "t,theta_o,dtheta_o,theta_m,dtheta_m,theta_L,dtheta_L,mode\n";
-  for (const numeric::TrajectorySample& s : result.samples)
-    appendf(out, "%.10g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%s\n", s.t, s.theta_o, s.dtheta_o, s.theta_m, s.dtheta_m,
-            s.theta_L, s.dtheta_L, s.in_contact ? (effects.compliant() ? "mesh" : "contact") : "free");
-  return out;
+  std::string out = csv_header;
+  const char* contact_mode = effects.compliant() ? "mesh" : "contact";
+  for (const numeric::TrajectorySample& s : result.samples) append_sample(out, s, contact_mode);
+  return out + csv_end(*this);
 }
 
 std::string Simulation::text() const {
@@ -161,6 +236,7 @@ std::string Simulation::text() const {
             e.body != numeric::Body::None ? (std::string("  ") + numeric::to_string(e.body)).c_str() : "");
   appendf(out, "final: t = %g  theta_o = %.10f  theta_m = %.10f  theta_L = %.10f  error theta_o - theta_R = %.10f\n",
           result.t_final, result.theta_o_final, result.final_state.theta_m, result.final_state.theta_L, final_error());
+  if (stopped_early()) out += stop_message() + "\n";
   return out;
 }
 

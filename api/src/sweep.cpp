@@ -1,122 +1,234 @@
-// sweep.cpp — limit cycles over a parameter (thesis figs. 31, 32, or any case), and the CSV.
+// sweep.cpp — limit cycles over a parameter (thesis figs. 31, 32, or any case), whole or
+// streamed, and the CSV.
 #include "backlash/api/backlash.hpp"
 
 #include "format.hpp"
 
+#include "backlash/symbolic/escape.hpp"
+
 #include <algorithm>
+#include <array>
+#include <cctype>
 #include <cmath>
+#include <memory>
 #include <sstream>
+#include <string_view>
 
 namespace backlash::api {
 
 namespace {
 
-std::string number_text(double value) {
-  std::string out;
-  detail::appendf(out, "%g", value);
-  return out;
+/// The largest point count: indices and x values stay exact in a double (2^40 / 3 per series).
+constexpr long largest_points = (1L << 40) / 3;
+constexpr int largest_threads = 1024;
+
+/// How a varied name sets x in the parameters or effects (`base`: the case's parameters).
+using Setter = void (*)(numeric::Parameters& p, numeric::Effects& e, const numeric::Parameters& base, double x);
+
+struct Varied {
+  std::string_view name;
+  Setter set;
+};
+
+constexpr std::array<Varied, 17> varied{{
+    {"Jm", [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters&, double x) { p.Jm = x; }},
+    {"Fm", [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters&, double x) { p.Fm = x; }},
+    {"JL", [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters&, double x) { p.JL = x; }},
+    {"FL", [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters&, double x) { p.FL = x; }},
+    {"K", [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters&, double x) { p.K = x; }},
+    {"backlash", [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters&, double x) { p.backlash = x; }},
+    {"reference", [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters&, double x) { p.theta_R = x; }},
+    {"JL_over_Jm",  // keeping J = Jm + JL
+     [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters& base, double x) {
+       const double J = base.Jm + base.JL;
+       p.Jm = J / (1 + x);
+       p.JL = J * x / (1 + x);
+     }},
+    {"FL_over_F",  // keeping F = Fm + FL
+     [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters& base, double x) {
+       const double F = base.Fm + base.FL;
+       p.FL = x * F;
+       p.Fm = F - p.FL;
+     }},
+    {"coulomb_motor", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.coulomb_motor = x; }},
+    {"coulomb_load", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.coulomb_load = x; }},
+    {"restitution", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.restitution = x; }},
+    {"saturation", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.saturation = x; }},
+    {"stiffness", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.mesh_stiffness = x; }},
+    {"damping", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.mesh_damping = x; }},
+    {"delay", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.delay = x; }},
+    {"torque_offset", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.torque_offset = x; }},
+}};
+
+std::string varied_names() {
+  std::string names;
+  for (const Varied& v : varied) names += (names.empty() ? "" : ", ") + std::string(v.name);
+  return names;
 }
 
-const char* vary_names =
-    "Jm, Fm, JL, FL, K, backlash, reference, JL_over_Jm, FL_over_F, coulomb_motor, coulomb_load, restitution, "
-    "saturation, stiffness, damping, delay, torque_offset";
+/// A case's sweep: its parameters and effects with one of them set to x_i.
+struct CaseSweep {
+  std::string series;
+  numeric::Parameters base;
+  numeric::Effects base_effects;
+  Setter set = nullptr;
+  double from = 0, to = 0;
+  long n = 1;
 
-std::vector<numeric::SweepPoint> case_points(const SweepRequest& r) {
-  if (r.vary.empty()) throw BadInput("vary", "required for a case (or use fig31 / fig32 as the target)");
-  if (!std::isfinite(r.from)) throw BadInput("from", "not finite, got " + number_text(r.from));
-  if (!std::isfinite(r.to)) throw BadInput("to", "not finite, got " + number_text(r.to));
-  const Case c = Case::load(r.target);
-  const numeric::Parameters base = c.parameters();
-  const numeric::Effects base_effects = c.effects();
-  const std::string& v = r.vary;
-  const int n = r.points;
-  std::vector<numeric::SweepPoint> points;
-  for (int i = 0; i < n; ++i) {
-    const double x = n == 1 ? r.from : r.from + (r.to - r.from) * i / double(n - 1);
-    numeric::Parameters p = base;
-    numeric::Effects e = base_effects;
-    if (v == "Jm") p.Jm = x;
-    else if (v == "Fm") p.Fm = x;
-    else if (v == "JL") p.JL = x;
-    else if (v == "FL") p.FL = x;
-    else if (v == "K") p.K = x;
-    else if (v == "backlash") p.backlash = x;
-    else if (v == "reference") p.theta_R = x;
-    else if (v == "JL_over_Jm") { const double J = base.Jm + base.JL; p.Jm = J / (1 + x); p.JL = J * x / (1 + x); }
-    else if (v == "FL_over_F") { const double F = base.Fm + base.FL; p.FL = x * F; p.Fm = F - p.FL; }
-    else if (v == "coulomb_motor") e.coulomb_motor = x;
-    else if (v == "coulomb_load") e.coulomb_load = x;
-    else if (v == "restitution") e.restitution = x;
-    else if (v == "saturation") e.saturation = x;
-    else if (v == "stiffness") e.mesh_stiffness = x;
-    else if (v == "damping") e.mesh_damping = x;
-    else if (v == "delay") e.delay = x;
-    else if (v == "torque_offset") e.torque_offset = x;
-    else throw BadInput("vary", "unknown parameter '" + v + "' (" + vary_names + ")");
+  double x(long i) const {
+    return n == 1 ? from : from + (to - from) * static_cast<double>(i) / static_cast<double>(n - 1);
+  }
+  numeric::SweepPoint point(long i) const {
+    numeric::SweepPoint out{series, x(i), base, base_effects};
+    set(out.parameters, out.effects, base, out.x);
+    return out;
+  }
+};
+
+/// Every constraint is an interval in x, so checking both ends checks every point.
+void check_ends(const CaseSweep& sweep, const std::string& vary) {
+  for (const long i : {0L, sweep.n - 1}) {
+    const numeric::SweepPoint pt = sweep.point(i);
+    const numeric::Parameters& p = pt.parameters;
+    const numeric::Effects& e = pt.effects;
+    const std::string end = i == 0 ? "from" : "to", at = vary + " = " + detail::number_text(pt.x);
     if (!(p.Jm > 0) || !(p.JL > 0) || p.Fm < 0 || p.FL < 0 || !(p.K > 0) || p.backlash < 0)
-      throw BadInput("from/to", v + " = " + std::to_string(x) + " gives non-physical parameters");
+      throw BadInput(end, at + " gives non-physical parameters");
     if (e.coulomb_motor < 0 || e.coulomb_load < 0 || e.restitution < 0 || e.restitution >= 1 || !(e.saturation > 0) ||
         !(e.mesh_stiffness > 0) || e.mesh_damping < 0 || e.delay < 0)
-      throw BadInput("from/to", v + " = " + std::to_string(x) + " is outside the effect's range (docs/effects.md)");
-    if (e.restitution > 0 && e.compliant())
-      throw BadInput("vary", v + ": restitution and compliance both model the impact; give one of them");
-    if ((v == "stiffness" || v == "damping") && !e.compliant())
-      throw BadInput("vary", v + ": the case has no [effects] compliance to vary (give one in the case file)");
-    points.push_back({c.id() + ":" + v, x, p, e});
+      throw BadInput(end, at + " is outside the effect's range (docs/effects.md)");
   }
-  return points;
+  const numeric::Effects& e = sweep.base_effects;
+  if ((vary == "restitution" && e.compliant()) || ((vary == "stiffness" || vary == "damping") && e.restitution > 0))
+    throw BadInput("vary", vary + ": restitution and compliance both model the impact; give one of them");
+  if ((vary == "stiffness" || vary == "damping") && !e.compliant())
+    throw BadInput("vary", vary + ": the case has no [effects] compliance to vary (give one in the case file)");
+}
+
+CaseSweep case_sweep(const SweepRequest& r) {
+  if (r.vary.empty()) throw BadInput("vary", "required for a case (or use fig31 / fig32 as the target)");
+  const auto found = std::find_if(varied.begin(), varied.end(), [&](const Varied& v) { return v.name == r.vary; });
+  if (found == varied.end()) throw BadInput("vary", "unknown parameter '" + r.vary + "' (" + varied_names() + ")");
+  for (const auto& [name, value] : {std::pair{"from", &r.from}, std::pair{"to", &r.to}}) {
+    if (!*value) throw BadInput(name, "required for a case");
+    if (!std::isfinite(**value)) throw BadInput(name, "not finite, got " + detail::number_text(**value));
+  }
+  const Case c = Case::load(r.target);
+  CaseSweep sweep{c.id() + ":" + r.vary, c.parameters(), c.effects(), found->set, *r.from, *r.to, r.points};
+  check_ends(sweep, r.vary);
+  return sweep;
+}
+
+/// A request checked: how many points, and each made on demand (from any thread).
+struct Plan {
+  long count = 0;
+  std::function<numeric::SweepPoint(long)> point;
+};
+
+void check_counts(const SweepRequest& r) {
+  if (r.points < 1) throw BadInput("points", "expected an integer >= 1, got " + std::to_string(r.points));
+  if (r.points > largest_points)
+    throw BadInput("points", "at most " + std::to_string(largest_points) + ", got " + std::to_string(r.points));
+  if (r.threads < 1) throw BadInput("threads", "expected an integer >= 1, got " + std::to_string(r.threads));
+  if (r.threads > largest_threads)
+    throw BadInput("threads", "at most " + std::to_string(largest_threads) + ", got " + std::to_string(r.threads));
+  if (r.target.empty()) throw BadInput("target", "expected fig31, fig32 or a case (I..VIII or a case file)");
+}
+
+Plan plan(const SweepRequest& r) {
+  check_counts(r);
+  const long n = r.points;
+  if (r.target == "fig31") return {2 * n, [n](long i) { return numeric::figure31_point(n, i); }};
+  if (r.target == "fig32") return {3 * n, [n](long i) { return numeric::figure32_point(n, i); }};
+  std::string lowered = r.target;
+  for (char& ch : lowered) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  std::error_code ignored;
+  if (lowered.rfind("fig", 0) == 0 && !std::filesystem::exists(r.target, ignored))
+    throw BadInput("target", "unknown figure '" + r.target +
+                                 "': the thesis's sweeps are fig31 and fig32 (or give a case with --vary)");
+  auto sweep = std::make_shared<const CaseSweep>(case_sweep(r));
+  return {n, [sweep](long i) { return sweep->point(i); }};
+}
+
+numeric::SweepOptions options_of(const SweepRequest& r) {
+  numeric::SweepOptions options;
+  options.threads = r.threads;
+  options.progress = r.progress;
+  return options;
 }
 
 }  // namespace
 
 std::vector<numeric::SweepPoint> sweep_points(const SweepRequest& r) {
-  if (r.points < 1) throw BadInput("points", "expected an integer >= 1, got " + std::to_string(r.points));
-  if (r.threads < 1) throw BadInput("threads", "expected an integer >= 1, got " + std::to_string(r.threads));
-  if (r.target.empty()) throw BadInput("target", "expected fig31, fig32 or a case (I..VIII or a case file)");
-  if (r.target == "fig31") return numeric::figure31_points(r.points);
-  if (r.target == "fig32") return numeric::figure32_points(r.points);
-  return case_points(r);
+  const Plan p = plan(r);
+  std::vector<numeric::SweepPoint> points;
+  points.reserve(static_cast<std::size_t>(p.count));
+  for (long i = 0; i < p.count; ++i) points.push_back(p.point(i));
+  return points;
 }
 
 Sweep sweep(const SweepRequest& r) {
   const std::vector<numeric::SweepPoint> points = sweep_points(r);
-  numeric::SweepOptions options;
-  options.threads = r.threads;
-  options.progress = r.progress;
   Sweep out;
   out.threads = r.threads;
-  out.rows = numeric::run_sweep(points, options, &out.summary);
+  out.rows = numeric::run_sweep(points, options_of(r), &out.summary);
+  out.points = static_cast<long>(out.rows.size());
+  return out;
+}
+
+Sweep sweep(const SweepRequest& r, const TextSink& csv, const std::function<void(const numeric::SweepRow&)>& row) {
+  const Plan p = plan(r);
+  Sweep out;
+  out.threads = r.threads;
+  csv(Sweep::csv_header());
+  numeric::run_sweep_streamed(
+      p.count, p.point, options_of(r),
+      [&](const numeric::SweepRow& done) {
+        csv(Sweep::csv_row(done));
+        ++out.points;
+        if (row) row(done);
+      },
+      &out.summary);
   return out;
 }
 
 std::string status_of(const numeric::SweepRow& row) { return detail::status_text(row.status); }
 
-std::string Sweep::csv() const {
+std::string Sweep::csv_header() {
+  return "series,x,Jm,Fm,JL,FL,K,backlash,effects,status,branches,peak_to_peak,amplitude,period,separation_velocity,"
+         "multiplier\n";
+}
+
+std::string Sweep::csv_row(const numeric::SweepRow& r) {
   std::ostringstream csv;
   csv.precision(12);
-  csv << "series,x,Jm,Fm,JL,FL,K,backlash,effects,status,branches,peak_to_peak,amplitude,period,separation_velocity,multiplier\n";
-  for (const numeric::SweepRow& r : rows) {
-    const numeric::Parameters& p = r.point.parameters;
-    std::string effects = r.point.effects.describe();
-    std::replace(effects.begin(), effects.end(), ',', ';');  // one CSV cell
-    effects.erase(std::remove(effects.begin(), effects.end(), ' '), effects.end());
-    csv << r.point.series << "," << r.point.x << "," << p.Jm << "," << p.Fm << "," << p.JL << "," << p.FL << "," << p.K << ","
-        << p.backlash << "," << effects << "," << status_of(r) << "," << r.branches;
-    if (status_of(r) == "limit_cycle") {
-      csv << "," << r.cycle.peak_to_peak << "," << r.cycle.amplitude << "," << r.cycle.period << ",";
-      if (std::isfinite(r.cycle.separation_velocity)) csv << r.cycle.separation_velocity;  // none: a pure bounce cycle
-      csv << "," << r.cycle.multiplier << "\n";
-    } else {
-      csv << ",,,,,\n";
-    }
+  const numeric::Parameters& p = r.point.parameters;
+  std::string effects = r.point.effects.describe();
+  std::replace(effects.begin(), effects.end(), ',', ';');  // one CSV cell
+  effects.erase(std::remove(effects.begin(), effects.end(), ' '), effects.end());
+  const std::string status = status_of(r);
+  csv << symbolic::escape::csv_field(r.point.series) << "," << r.point.x << "," << p.Jm << "," << p.Fm << "," << p.JL
+      << "," << p.FL << "," << p.K << "," << p.backlash << "," << effects << "," << status << "," << r.branches;
+  if (status == "limit_cycle") {
+    csv << "," << r.cycle.peak_to_peak << "," << r.cycle.amplitude << "," << r.cycle.period << ",";
+    if (std::isfinite(r.cycle.separation_velocity)) csv << r.cycle.separation_velocity;  // none: a pure bounce cycle
+    csv << "," << r.cycle.multiplier << "\n";
+  } else {
+    csv << ",,,,,\n";
   }
   return csv.str();
 }
 
+std::string Sweep::csv() const {
+  std::string out = csv_header();
+  for (const numeric::SweepRow& r : rows) out += csv_row(r);
+  return out;
+}
+
 std::string Sweep::summary_line() const {
   std::string out;
-  detail::appendf(out, "sweep: %zu points on %d threads; parametric family validated at %ld samples (%ld failed), branches:",
-                  rows.size(), threads, summary.validated_samples, summary.failed_samples);
+  detail::appendf(out, "sweep: %ld points on %d threads; parametric family validated at %ld samples (%ld failed), branches:",
+                  points, threads, summary.validated_samples, summary.failed_samples);
   for (const std::string& b : summary.covered_branches) out += " " + b;
   return out + "\n";
 }

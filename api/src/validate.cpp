@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <sstream>
 
 namespace backlash::api {
@@ -53,59 +54,81 @@ void print_report(std::ostream& out, const numeric::ValidationReport& r) {
   for (std::string line; std::getline(lines, line);) out << "    " << line << "\n";
 }
 
+/// The gate run on evaluator after evaluator: the text report, the failures, each one's JSON.
+struct Gate {
+  numeric::ValidationOptions options;
+  std::ostringstream text;
+  std::vector<std::string> failures;
+
+  nlohmann::json run(const numeric::EvaluatorPtr& evaluator, const std::string& where) {
+    const numeric::ValidationResult result = numeric::validate(evaluator, options);
+    const numeric::ValidationReport& report = result.report();
+    if (!result.passed()) failures.push_back(where + ": " + report.evaluator + " (" + report.failures() + ")");
+    print_report(text, report);
+    return to_json(report);
+  }
+};
+
+/// A case's evaluators: its generated one (a thesis case with its own numbers), the stable
+/// parametric one, the direct per-branch formulas.
+void validate_case(Gate& gate, const Case& source, nlohmann::json& document) {
+  const model::CaseSpec& spec = source.spec();
+  const numeric::Parameters p = source.parameters();
+  std::vector<numeric::EvaluatorPtr> evaluators;
+  const numeric::EvaluatorPtr primary = numeric::case_evaluator(spec);
+  evaluators.push_back(primary);
+  if (primary->kind() != "parametric") evaluators.push_back(numeric::parametric_evaluator(p));
+  evaluators.push_back(numeric::direct_branch_evaluator(p));
+  gate.text << "case " << spec.id << " (" << spec.name << "), tolerance " << gate.options.tolerance << "\n";
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& e : evaluators) list.push_back(gate.run(e, "case " + spec.id));
+  document["case"] = spec.id;
+  document["parameters"] = parameters_json(p);
+  document["evaluators"] = list;
+}
+
+/// The parametric and direct evaluators at a representative point of every pole-structure branch.
+void validate_branches(Gate& gate, nlohmann::json& document) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const numeric::BranchRepresentative& rep : numeric::branch_representatives()) {
+    const std::string name = numeric::branch_name(rep.branch);
+    gate.text << "branch " << name << " (" << rep.description << ")\n";
+    nlohmann::json evaluators = nlohmann::json::array();
+    evaluators.push_back(gate.run(numeric::parametric_evaluator(rep.parameters), "branch " + name));
+    evaluators.push_back(gate.run(numeric::direct_branch_evaluator(rep.parameters), "branch " + name));
+    list.push_back({{"branch", name},
+                    {"description", rep.description},
+                    {"parameters", parameters_json(rep.parameters)},
+                    {"evaluators", evaluators}});
+  }
+  document["branches"] = list;
+}
+
 }  // namespace
 
 Validation validate(const std::optional<Case>& source, bool branches, double tolerance) {
   if (!source && !branches) throw BadInput("case", "give a case (I..VIII or a case file) and/or the branches");
   if (!(tolerance > 0)) throw BadInput("tolerance", "must be positive");
-  numeric::ValidationOptions gate;
-  gate.tolerance = tolerance;
-
-  Validation out;
+  if (!std::isfinite(tolerance)) throw BadInput("tolerance", "must be finite, got " + detail::number_text(tolerance));
+  if (source) detail::check_parameter_scales(source->spec());  // what double precision cannot compute, before any work
+  Gate gate;
+  gate.options.tolerance = tolerance;
   nlohmann::json document;
-  std::ostringstream text;
-  auto run = [&](const numeric::EvaluatorPtr& evaluator, const std::string& where) {
-    const numeric::ValidationResult result = numeric::validate(evaluator, gate);
-    if (!result.passed()) out.failures.push_back(where + ": " + result.report().evaluator);
-    print_report(text, result.report());
-    return to_json(result.report());
-  };
-
-  if (source) {
-    const model::CaseSpec& spec = source->spec();
-    const numeric::Parameters p = source->parameters();
-    std::vector<numeric::EvaluatorPtr> evaluators;
-    const numeric::EvaluatorPtr primary = numeric::case_evaluator(spec);
-    evaluators.push_back(primary);
-    if (primary->kind() != "parametric") evaluators.push_back(numeric::parametric_evaluator(p));
-    evaluators.push_back(numeric::direct_branch_evaluator(p));
-    text << "case " << spec.id << " (" << spec.name << "), tolerance " << gate.tolerance << "\n";
-    nlohmann::json list = nlohmann::json::array();
-    for (const auto& e : evaluators) list.push_back(run(e, "case " + spec.id));
-    document["case"] = spec.id;
-    document["parameters"] = parameters_json(p);
-    document["evaluators"] = list;
-  }
-  if (branches) {
-    nlohmann::json list = nlohmann::json::array();
-    for (const numeric::BranchRepresentative& rep : numeric::branch_representatives()) {
-      const std::string name = numeric::branch_name(rep.branch);
-      text << "branch " << name << " (" << rep.description << ")\n";
-      nlohmann::json evaluators = nlohmann::json::array();
-      evaluators.push_back(run(numeric::parametric_evaluator(rep.parameters), "branch " + name));
-      evaluators.push_back(run(numeric::direct_branch_evaluator(rep.parameters), "branch " + name));
-      list.push_back({{"branch", name},
-                      {"description", rep.description},
-                      {"parameters", parameters_json(rep.parameters)},
-                      {"evaluators", evaluators}});
-    }
-    document["branches"] = list;
-  }
-  document["tolerance"] = gate.tolerance;
+  if (source) validate_case(gate, *source, document);
+  if (branches) validate_branches(gate, document);
+  document["tolerance"] = gate.options.tolerance;
+  Validation out;
+  out.failures = std::move(gate.failures);
   document["passed"] = out.failures.empty();
   out.document = detail::document(document);
-  out.report = text.str() + (out.failures.empty() ? "all evaluators passed\n" : "");
+  out.report = gate.text.str() + (out.failures.empty() ? "all evaluators passed\n" : "");
   return out;
+}
+
+std::string Validation::failure_message() const {
+  std::string joined;
+  for (const std::string& f : failures) joined += (joined.empty() ? "" : "; ") + f;
+  return "validation failed: " + joined;
 }
 
 }  // namespace backlash::api

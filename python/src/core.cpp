@@ -198,6 +198,8 @@ void bind_simulation(py::module_& m) {
       .def_readonly("step", &api::Simulation::step)
       .def_readonly("t_end", &api::Simulation::t_end)
       .def_property_readonly("status", [](const api::Simulation& s) { return std::string(numeric::to_string(s.result.status)); })
+      .def_property_readonly("stopped_early", &api::Simulation::stopped_early)
+      .def_property_readonly("stop_reason", [](const api::Simulation& s) { return s.result.stop_reason; })
       .def_property_readonly("events", [](const api::Simulation& s) { return events_list(s.result.events); })
       .def_property_readonly("final", [](const api::Simulation& s) {
         const numeric::HybridState& f = s.result.final_state;

@@ -30,11 +30,17 @@
 // backlash::api_derive), so that a program using this header alone never links GiNaC.
 //
 // Errors: bad input — an argument out of range, a bad case file (model::CaseFileError), a
-// bad record (measurements::MeasuredDataError), or api::BadInput below — is an exception
-// whose what() is one line naming the file, line and key, or the argument; the CLI prints
-// it and exits 2.  A case whose evaluator fails its gate is numeric::ValidationFailed
-// (one line naming the failing states; exit 1).  Nothing is written before the input is
-// known good.
+// bad record (measurements::MeasuredDataError), parameters whose time scales double
+// precision cannot handle (numeric/scales.hpp: refused before any work), or api::BadInput
+// below — is an exception whose what() is one line naming the file, line and key, or the
+// argument; the CLI prints it and exits 2.  A case whose evaluator fails its gate is
+// numeric::ValidationFailed (one line naming the failing states; exit 1).  Nothing is
+// written before the input is known good.  A simulation that stops before its end time
+// (chattering, event cap, ...) is no error: Simulation::stopped_early() says so (the CLI's
+// exit code 3).
+//
+// Long outputs stream: Model::simulate_csv and the sweep() taking a TextSink hand their
+// CSV over row by row as it is computed, so memory stays flat in the output's length.
 //
 // Threads: every function here may run concurrently on different objects (numeric work
 // only); sweep() and discrepancy() use `threads` worker threads themselves.
@@ -59,6 +65,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -83,6 +90,11 @@ class BadInput : public std::invalid_argument {
 /// True for the exceptions that mean bad input (BadInput, model::CaseFileError,
 /// measurements::MeasuredDataError): the CLI's exit code 2, Python's ValueError.
 bool is_bad_input(const std::exception& error);
+
+/// Where a streamed output goes: called with each piece of text in order (a CSV's header,
+/// then one row at a time), e.g. [](std::string_view text) { std::cout << text; }.  An
+/// exception it throws stops the computation and is passed on.
+using TextSink = std::function<void(std::string_view)>;
 
 // ====================================================================== 1. a case
 
@@ -154,14 +166,24 @@ struct Simulation {
   numeric::Effects effects;
   /// Events (separation, recombination, recontact, rest, stick, slip, saturation,
   /// desaturation; t [s], θo [rad], θ̇o [rad/s] after the event), the final state, the
-  /// status (completed, rest, chattering, event_limit, non_finite), and the trajectory
-  /// samples when a sample interval was asked for.
+  /// status (completed, rest, chattering, event_limit, non_finite, unresolved, work_limit),
+  /// stop_reason for an early stop, and the trajectory samples when a sample interval was
+  /// asked for (none from Model::simulate_csv, which streams them).
   numeric::SimulationResult result;
 
   /// θo − θR at the end [rad].
   double final_error() const { return result.theta_o_final - parameters.theta_R; }
-  std::string json() const;  ///< `simulate CASE --json`
-  std::string csv() const;   ///< `simulate CASE --csv`: t,theta_o,dtheta_o,theta_m,dtheta_m,theta_L,dtheta_L,mode
+  /// True when the run ended before t_end without the model stopping by itself
+  /// (numeric::stopped_early: chattering, event_limit, non_finite, unresolved, work_limit):
+  /// everything up to the stop is valid; the CLI exits 3 (docs/design.md, "Exit 3").
+  bool stopped_early() const;
+  /// "stopped early at t = T (STATUS): REASON", the line the CLI prints on stderr; empty
+  /// when the run did not stop early.
+  std::string stop_message() const;
+  std::string json() const;  ///< `simulate CASE --json` (with "stop_reason" after an early stop)
+  /// `simulate CASE --csv`: t,theta_o,dtheta_o,theta_m,dtheta_m,theta_L,dtheta_L,mode, and
+  /// a last line "# stopped early at t = …" after an early stop.
+  std::string csv() const;
   std::string text() const;  ///< `simulate CASE`
 };
 
@@ -195,6 +217,7 @@ struct Cycle {
   numeric::Effects effects;
   numeric::LimitCycle cycle;
   /// "limit_cycle", "none" (reason in cycle.reason) or "divergent": the CLI's `status`.
+  /// The one place the numeric layer's status is turned into text.
   std::string status() const;
   bool found() const { return status() == "limit_cycle"; }
   std::string json() const;  ///< `limit-cycle CASE --json`
@@ -203,9 +226,12 @@ struct Cycle {
 
 // ====================================================================== 2. the validated model
 
-/// A case through its validation gates.  Construction runs them (a few milliseconds for a
-/// thesis case) and throws numeric::ValidationFailed — "case V: the evaluator failed
-/// validation against odeint (theta_m, gap); refusing to use it" — when one fails.
+/// A case through its validation gates.  Construction first refuses parameters whose time
+/// scales double precision or the certified event searches cannot handle (numeric/scales.hpp:
+/// model::CaseFileError "FILE: cannot be computed in double precision: K, motor.J: …",
+/// before any work), then runs the gates (a few milliseconds for a thesis case) and throws
+/// numeric::ValidationFailed — "case V: the evaluator failed validation against odeint
+/// (theta_m, gap); refusing to use it" — when one fails.
 class Model {
  public:
   explicit Model(Case source);
@@ -219,8 +245,12 @@ class Model {
   const numeric::ValidatedEffectModel& effect_model() const { return effects_.model(); }
 
   /// The step response.  BadInput "step" (none given and the case has no step
-  /// experiment), "t_end" (<= 0), "sample_interval" (< 0).
+  /// experiment, or a step too large for double precision to resolve the backlash against,
+  /// numeric/scales.hpp), "t_end" (<= 0), "sample_interval" (< 0).
   Simulation simulate(const SimulationRequest& request = {}) const;
+  /// The same, its CSV (Simulation::csv(), byte for byte) handed to `csv` as it is computed:
+  /// the header, each sample, the early-stop line.  sample_interval must be > 0.
+  Simulation simulate_csv(const SimulationRequest& request, const TextSink& csv) const;
   /// The dividing lines at these θ̇m0 [rad/s] (default: the thesis's values and a
   /// log-spaced sweep, numeric::default_dividing_line_grid).  BadInput "v0" for an empty
   /// or non-finite list.
@@ -247,24 +277,29 @@ struct SweepRequest {
   /// (keeping Fm + FL), or an effect's parameter: coulomb_motor coulomb_load restitution
   /// saturation stiffness damping delay torque_offset.
   std::string vary{};
-  double from = 0, to = 0;  ///< x_i = from + (to − from)·i/(points − 1)
-  int points = 101;         ///< per series, >= 1
-  int threads = 2;          ///< >= 1
+  /// For a case: x_i = from + (to − from)·i/(points − 1).
+  std::optional<double> from{}, to{};
+  long points = 101;  ///< per series, 1 … 2^40/3 (indices and x stay exact in a double)
+  int threads = 2;    ///< 1 … 1024
   /// Called from the worker threads (serialised) with (done, total).
   std::function<void(long, long)> progress{};
 };
 
 /// A sweep row's status as text ("limit_cycle", "none", "divergent", "unvalidated",
-/// "refused", "error"): the CSV's `status` column.
+/// "refused", "error"): the CSV's `status` column.  The one place the numeric layer's row
+/// status is turned into text.
 std::string status_of(const numeric::SweepRow& row);
 
 struct Sweep {
-  std::vector<numeric::SweepRow> rows;  ///< in the order of the points
+  std::vector<numeric::SweepRow> rows;  ///< in the order of the points (empty when streamed)
   numeric::SweepSummary summary;
+  long points = 0;  ///< rows computed (all series)
   int threads = 0;
   /// `sweep ... --out F`'s CSV: series,x,Jm,Fm,JL,FL,K,backlash,effects,status,branches,
   /// peak_to_peak,amplitude,period,separation_velocity,multiplier (12 significant digits).
   std::string csv() const;
+  static std::string csv_header();                        ///< the CSV's first line
+  static std::string csv_row(const numeric::SweepRow& row);  ///< one row's line
   /// The one line `sweep` prints on stderr: points, threads, validated samples, branches.
   std::string summary_line() const;
 };
@@ -274,6 +309,11 @@ struct Sweep {
 std::vector<numeric::SweepPoint> sweep_points(const SweepRequest& request);
 /// The sweep.  A point's own failure is a status in its row, never an exception.
 Sweep sweep(const SweepRequest& request);
+/// The same, streamed: the CSV (Sweep::csv(), byte for byte) handed to `csv` row by row, in
+/// order, as the rows are done, and each row to `row` when given; the points are made on
+/// demand, so memory does not grow with their number.  The result keeps no rows.
+Sweep sweep(const SweepRequest& request, const TextSink& csv,
+            const std::function<void(const numeric::SweepRow&)>& row = {});
 
 // ====================================================================== 4. discrepancy
 
@@ -352,13 +392,18 @@ Discrepancy discrepancy(const Case& model, const measurements::MeasuredRecord& d
 struct Validation {
   std::string document;  ///< `validate ... --json`
   std::string report;    ///< `validate ...` (text)
-  std::vector<std::string> failures;  ///< "case V: parametric", ... (empty: all passed)
+  /// "case V: parametric (theta_m: max |error| … > tolerance)", ... (empty: all passed)
+  std::vector<std::string> failures;
   bool passed() const { return failures.empty(); }
   std::string json() const { return document; }
   std::string text() const { return report; }
+  /// "validation failed: FAILURE; FAILURE" — the CLI's one line instead of the report.
+  std::string failure_message() const;
 };
 
-/// BadInput "tolerance" (<= 0); BadInput "case" when neither a case nor branches is asked for.
+/// BadInput "tolerance" (<= 0 or not finite); BadInput "case" when neither a case nor
+/// branches is asked for.  A case whose time scales double precision cannot handle is
+/// refused before any work (model::CaseFileError, numeric/scales.hpp).
 Validation validate(const std::optional<Case>& source, bool branches, double tolerance = 1e-9);
 
 }  // namespace backlash::api

@@ -1,0 +1,72 @@
+// backlash/cli/flags.hpp — the numbers of the command line's flags, read strictly: a bad
+// value is a UsageError naming the flag (exit 2).  Whether a value is in range is the
+// facade's to judge (backlash/api/backlash.hpp); its BadInput names the flag (main.cpp).
+#pragma once
+
+#include "commands.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace backlash::cli {
+
+/// A finite number, or UsageError naming the flag and what is wrong: not a number at all, or
+/// one double precision cannot hold (beyond ±1.8e308, or nonzero below 2.2e-308 in size, where
+/// it keeps fewer digits — use 0 or a larger value).
+inline double parse_number(const std::string& text, const std::string& flag) {
+  const auto first = text.find_first_not_of(" \t");
+  if (first == std::string::npos) throw UsageError(flag + ": empty value");
+  const std::string trimmed = text.substr(first, text.find_last_not_of(" \t") - first + 1);
+  const char* begin = trimmed.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double value = std::strtod(begin, &end);
+  const int range = errno;
+  if (end == begin || *end != '\0') throw UsageError(flag + ": '" + text + "' is not a number");
+  if (std::isnan(value) || (std::isinf(value) && range != ERANGE)) throw UsageError(flag + ": '" + text + "' is not finite");
+  if (range == ERANGE && std::isinf(value))
+    throw UsageError(flag + ": '" + text + "' is too large for double precision (beyond 1.8e308)");
+  if (value != 0 && !std::isnormal(value))
+    throw UsageError(flag + ": '" + text + "' is too small for double precision (nonzero below 2.2e-308 in size); "
+                     "use 0 or a larger value");
+  if (range == ERANGE && value == 0)
+    throw UsageError(flag + ": '" + text + "' is too small for double precision (nonzero below 2.2e-308 in size); "
+                     "use 0 or a larger value");
+  return value;
+}
+
+/// A comma-separated list of numbers; empty entries are errors.
+inline std::vector<double> parse_number_list(const std::string& text, const std::string& flag) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    const auto first = item.find_first_not_of(" \t"), last = item.find_last_not_of(" \t");
+    if (first == std::string::npos) throw UsageError(flag + ": empty entry in '" + text + "'");
+    values.push_back(parse_number(item.substr(first, last - first + 1), flag));
+  }
+  if (values.empty() || text.back() == ',') throw UsageError(flag + ": empty entry in '" + text + "'");
+  return values;
+}
+
+/// A whole number (e.g. --points 1e3), or UsageError naming the flag.
+inline long parse_whole_number(const std::string& text, const std::string& flag) {
+  const double v = parse_number(text, flag);
+  if (v != std::floor(v)) throw UsageError(flag + ": expected a whole number, got '" + text + "'");
+  if (std::fabs(v) > 9e15) throw UsageError(flag + ": '" + text + "' is too large");
+  return static_cast<long>(v);
+}
+
+/// The same, for an int-sized count (larger values become the largest int, which the facade refuses).
+inline int parse_whole_int(const std::string& text, const std::string& flag) {
+  const long v = parse_whole_number(text, flag);
+  const long largest = std::numeric_limits<int>::max();
+  return static_cast<int>(v > largest ? largest : v < -largest ? -largest : v);
+}
+
+}  // namespace backlash::cli
