@@ -128,3 +128,24 @@ def test_no_ginac_until_derive():
     run = subprocess.run([sys.executable, "-c", program], capture_output=True, text=True)
     assert run.returncode == 0, run.stderr
     expect_equal("GiNaC, CLN mapped before derive(); GiNaC after", run.stdout.split(), ["False", "False", "True"])
+
+
+
+def test_early_stop_is_a_status_with_its_reason(tmp_path):
+    # Undamped, the cycle grows until the event cap ends the run long before t_end: no
+    # exception, the result says so; the CLI prints the same JSON and exits 3.
+    import subprocess
+    from known import CLI
+    grows = backlash.load(name="grows", measured_at="load", Jm="1/2", Fm=0, JL="1/2", FL=0, K=1, backlash="3/10",
+                          reference=1)
+    run = grows.simulate(step=0.62, t_end=2e5, dt=0)
+    assert run.stopped_early, f"simulate() returned status {run.status} instead of an early stop"
+    expect_equal("simulate().status", run.status, "event_limit")
+    assert "event cap" in run.stop_reason, run.stop_reason
+    assert str(run).endswith(f"): {run.stop_reason}"), str(run)[-200:]
+    case_file = tmp_path / "grows.toml"
+    case_file.write_text(grows.case_file())
+    printed = subprocess.run([CLI, "simulate", str(case_file), "--step", "0.62", "--t-end", "2e5", "--json"],
+                             capture_output=True, text=True)
+    expect_equal("the CLI's exit code", printed.returncode, 3)
+    expect_equal("simulate().json()", run.json(), printed.stdout)
