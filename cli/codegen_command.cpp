@@ -4,8 +4,8 @@
 #include "commands.hpp"
 #include "output_files.hpp"
 
+#include "backlash/api/backlash.hpp"
 #include "backlash/codegen/emit.hpp"
-#include "backlash/model/case_spec.hpp"
 
 #include <iostream>
 #include <memory>
@@ -24,10 +24,10 @@ void run_codegen(const CodegenOptions& options) {
   const std::filesystem::path out(options.out);
   if (std::filesystem::exists(out) && !std::filesystem::is_directory(out))
     throw UsageError("codegen: --out " + options.out + " exists and is not a folder");
-  const model::CaseSpec spec = model::load_case(options.case_name);
+  const api::Case source = api::load(options.case_name);  // the one route to a case
   OutputFiles files;
   std::vector<std::filesystem::path> names;
-  for (auto& file : codegen::emit_case_files(spec)) {
+  for (auto& file : codegen::emit_case_files(source.spec())) {
     names.push_back(out / file.relative);
     files.add(file.relative, std::move(file.content));
   }
