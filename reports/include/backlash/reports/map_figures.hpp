@@ -22,7 +22,9 @@
 //     parameter), each figure linked.
 // Bins: a grid axis has one bin per grid value (consecutive values share a bin beyond
 // max_bins_per_axis); a sampled axis has `bins` equal bins, in log10 of the value when
-// log_scale.  Same points in the same order give the same bytes.
+// log_scale (grid values: from + (to − from)·k/(N − 1), or geometric on a log axis).
+// Same points in the same order give the same bytes.  docs/map-figures.md: the figures,
+// the contour and the estimator (with its bias for few points per bin).
 #pragma once
 
 #include <cstdint>
