@@ -81,6 +81,8 @@ struct MapField {
   std::vector<double> boundary_x, boundary_y;  ///< exact crossings along p or q (at most max_boundary_markers)
 };
 
+/// Not thread-safe: one thread adds the points (under MPI, the rank that gathers them, in
+/// index order — binning per rank and merging would make the sums depend on the rank count).
 class MapFigures {
  public:
   static constexpr int max_bins_per_axis = 200;        ///< beyond it, grid values share bins
@@ -108,7 +110,8 @@ class MapFigures {
 
   /// Writes figures/map_P_Q.svg (+ .pdf when gnuplot can) for every pair and summary.md
   /// into `directory` (which exists).  Returns the reason when figures could not be drawn
-  /// (gnuplot missing), else an empty string; summary.md is always written.
+  /// (gnuplot missing), else an empty string; summary.md is always written (staged, then
+  /// renamed into place; std::runtime_error when it cannot be written).
   std::string write(const std::filesystem::path& directory) const;
 
  private:
