@@ -21,8 +21,9 @@
 //     index Var(E[magnitude | parameter]) / Var(magnitude), estimated from the bins of each
 //     parameter), each figure linked.
 // Bins: a grid axis has one bin per grid value (consecutive values share a bin beyond
-// max_bins_per_axis); a sampled axis has `bins` equal bins, in log10 of the value when
-// log_scale (grid values: from + (to − from)·k/(N − 1), or geometric on a log axis).
+// max_bins_per_axis); a sampled axis has `bins` equal bins (at most max_bins_per_axis), in
+// log10 of the value when log_scale (grid values: from + (to − from)·k/(N − 1), or
+// geometric on a log axis).
 // Same points in the same order give the same bytes.  docs/map-figures.md: the figures,
 // the contour and the estimator (with its bias for few points per bin).
 #pragma once
