@@ -412,7 +412,8 @@ doc::Document segment_blocks(const SegmentView& v, const CaseParameters& p, cons
                                  doc::math("A_r = \\frac{1}{(m-r)!}\\frac{d^{m-r}}{ds^{m-r}}\\left[(s-p)^m F(s)\\right]_{s=p}") +
                                  doc::text(" (a complex pair by its coefficient at the upper pole; the term is twice the real part):")));
     out.push_back(doc::table(header, rows, "lrrll"));
-    out.back().latex_columns = "p{2.6cm}rrp{4.4cm}p{5.6cm}";
+    // ragged right: a long coefficient breaks after a "+" and the "+" stays beside it
+    out.back().latex_columns = "p{2.6cm}rr>{\\raggedright\\arraybackslash}p{4.4cm}>{\\raggedright\\arraybackslash}p{5.6cm}";
     out.back().small = true;
     out.push_back(doc::paragraph(doc::text("The partial fractions:")));
     out.push_back(doc::equation(pp::display(v.laplace_lhs, partial_fraction_terms(steps, pp::latex_exact),
@@ -663,9 +664,15 @@ doc::Document derivation_document(const CaseDerivation& d, const EquationTags& t
         "\\exp\\left(\\frac{a}{\\omega_c}\\arctan\\frac{\\dot\\theta_o - a e}{\\omega_c e}\\right)"));
     if (omega) {
       const ex w = canonical_sqrt(omega->square);
-      out.push_back(doc::equation("C = " + pp::latex(1 / w) + "\\sqrt{\\dot\\theta_o^{2} - " + pp::latex(F / J) + "\\,\\dot\\theta_o e + " +
-                                  pp::latex(p.K / J) + "\\,e^{2}}\\;\\exp\\left(" + pp::latex(a / w) +
-                                  "\\arctan\\frac{\\dot\\theta_o - " + pp::latex(a) + "\\,e}{" + pp::latex(w) + "\\,e}\\right)"));
+      // c·body with the case's numbers: "e^{2}" for 1·e², nothing for 0 (no "1\,e^{2}", no "- 0\,…")
+      const auto times = [](const ex& c, const std::string& body) {
+        return c.is_zero() ? std::string() : (c.is_equal(1) ? body : pp::latex(c) + "\\," + body);
+      };
+      const std::string damping = (F / J).is_zero() ? "" : " - " + times(F / J, "\\dot\\theta_o e");
+      const std::string shift = a.is_zero() ? "" : " - " + times(a, "e");
+      out.push_back(doc::equation("C = " + pp::latex(1 / w) + "\\sqrt{\\dot\\theta_o^{2}" + damping + " + " + times(p.K / J, "e^{2}") +
+                                  "}\\;\\exp\\left(" + pp::latex(a / w) + "\\arctan\\frac{\\dot\\theta_o" + shift + "}{" +
+                                  times(w, "e") + "}\\right)"));
     }
     out.push_back(doc::paragraph(doc::math("d\\ln C/dt = " + pp::latex(sc.dlnC_dt)) +
                                  doc::text(" exactly along every contact trajectory.  Crossing ") + doc::math("\\theta_o = \\theta_R") +
@@ -689,11 +696,42 @@ doc::Document derivation_document(const CaseDerivation& d, const EquationTags& t
   return out;
 }
 
+namespace {
+
+// A branch condition ("output at motor; Fm^2 < 4*Jm*K; FL = 0") as a reader's text:
+// the words as words, the relations as mathematics (F_m^2 < 4J_mK).
+doc::Rich condition_rich(const std::string& condition) {
+  doc::Rich out;
+  for (std::size_t from = 0; from < condition.size();) {
+    const std::size_t end = std::min(condition.find("; ", from), condition.size());
+    const std::string clause = condition.substr(from, end - from);
+    if (!out.empty()) out = out + doc::text("; ");
+    if (clause.rfind("output at ", 0) == 0) {
+      out = out + doc::text(clause);
+    } else {
+      std::string math;
+      for (std::size_t k = 0; k < clause.size(); ++k) {
+        const char c = clause[k], next = k + 1 < clause.size() ? clause[k + 1] : '\0';
+        if ((c == 'F' || c == 'J') && (next == 'm' || next == 'L')) math += std::string(1, c) + "_" + next, ++k;
+        else if (c == '*') continue;
+        else if (c == '!' && next == '=') math += "\\neq", ++k;
+        else if (c == ',') math += ",\\ ";
+        else math += c;
+      }
+      out = out + doc::math(math);
+    }
+    from = end + 2;
+  }
+  return out;
+}
+
+}  // namespace
+
 doc::Document general_document(const std::vector<GeneralBranch>& branches, int level) {
   doc::Document out;
   for (const GeneralBranch& b : branches) {
     out.push_back(doc::heading(level, doc::text("Branch ") + doc::code(b.name)));
-    out.push_back(doc::paragraph(doc::text("Where it applies: ") + doc::code(b.condition) + doc::text(".")));
+    out.push_back(doc::paragraph(doc::text("Where it applies: ") + condition_rich(b.condition) + doc::text(".")));
     for (const BranchParameter& bp : b.branch_parameters)
       out.push_back(doc::paragraph(doc::math(pp::latex_symbol_name(bp.symbol.get_name()) + " = \\sqrt{" +
                                              pp::latex(bp.square_in_physical_parameters) + "}") +

@@ -1,7 +1,9 @@
 #include "backlash/symbolic/document.hpp"
 
 #include "backlash/symbolic/escape.hpp"
+#include "backlash/symbolic/pretty.hpp"
 
+#include <algorithm>
 #include <sstream>
 
 namespace backlash::symbolic::doc {
@@ -183,7 +185,20 @@ std::string to_latex(const Document& document, const LatexOptions& options) {
       case Block::Kind::Paragraph: out << latex_rich(b.content) << "\n\n"; break;
       case Block::Kind::Equation: {
         const bool tagged = b.equation.find("\\tag{") != std::string::npos;
-        out << "\\begin{equation*}\n" << b.equation << (tagged ? "" : "") << "\n\\end{equation*}\n\n";
+        // A line that no break between summands can bring within the text width (a single
+        // wide fraction of the general solutions) is scaled down to fit; an untagged
+        // equation only (a \tag cannot sit in a box), and never scaled up.
+        std::size_t widest = 0;
+        for (std::size_t from = 0; from <= b.equation.size();) {
+          const std::size_t end = std::min(b.equation.find("\\\\", from), b.equation.size());
+          widest = std::max(widest, pretty::visible_width(b.equation.substr(from, end - from)));
+          from = end + 2;
+        }
+        if (!tagged && widest > 100)
+          out << "\\begin{equation*}\n\\resizebox{\\ifdim\\width>\\linewidth\\linewidth\\else\\width\\fi}{!}{$\\displaystyle "
+              << b.equation << "$}\n\\end{equation*}\n\n";
+        else
+          out << "\\begin{equation*}\n" << b.equation << "\n\\end{equation*}\n\n";
         break;
       }
       case Block::Kind::Table: {
@@ -212,13 +227,17 @@ std::string to_latex(const Document& document, const LatexOptions& options) {
         std::string safe;
         std::istringstream lines(source);
         std::string line;
+        std::size_t longest = 0;
         while (std::getline(lines, line)) {
+          longest = std::max(longest, line.size());
           if (line.find("\\end{verbatim}") != std::string::npos) line = "  (line omitted)";
           std::string printable;
           for (char c : line) printable += (static_cast<unsigned char>(c) < 0x20 && c != '\t') || static_cast<unsigned char>(c) >= 0x80 ? '?' : c;
           safe += printable + "\n";
         }
-        out << "{\\footnotesize\n\\begin{verbatim}\n" << safe << "\\end{verbatim}\n}\n\n";
+        // a verbatim line cannot wrap: past ~112 characters (the text width at 8 pt) the
+        // block is set at 7 pt, which holds ~133
+        out << (longest > 112 ? "{\\scriptsize" : "{\\footnotesize") << "\n\\begin{verbatim}\n" << safe << "\\end{verbatim}\n}\n\n";
         break;
       }
       case Block::Kind::List:
