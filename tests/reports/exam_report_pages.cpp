@@ -142,6 +142,27 @@ TEST(CasePages, ProseNamesQuantitiesAsAReaderWould) {
   }
 }
 
+TEST(Index, EveryNumberOfTheCaseTableIsTheOneOnTheCasePage) {
+  // The index's row of a case (exact magnitude, thesis vs exact, describing function) and
+  // the case page print the same numbers.
+  const reports::BuiltReport& report = built();
+  const std::string& index = report.files.at("README.md");
+  for (const auto& [id, path] : report.case_pages) {
+    const std::string head = "| [" + id + "](" + path + ") |";
+    const auto at = index.find(head);
+    ASSERT_NE(at, std::string::npos) << "the index has no row for case " << id;
+    std::vector<std::string> cells;
+    std::stringstream row(index.substr(at + head.size(), index.find('\n', at) - at - head.size()));
+    std::string cell;
+    while (std::getline(row, cell, '|')) cells.push_back(cell.substr(1, cell.size() - 2));
+    ASSERT_GE(cells.size(), 8u) << "case " << id << ": returned " << cells.size() << " cells";
+    const std::string& page = report.files.at(path);
+    for (std::size_t k : {3u, 5u, 6u})  // exact magnitude, thesis vs exact, describing function
+      if (cells[k] != "—" && cells[k] != "n/a" && cells[k] != "none" && cells[k] != "agree: none")
+        EXPECT_NE(page.find(cells[k]), std::string::npos) << "case " << id << ": the index says " << cells[k] << ", the page does not";
+  }
+}
+
 TEST(CasePages, CoefficientsOfOneAreNotPrinted) {
   // "+ 1\,e^{2}" in eq. 38 with the case's numbers: a coefficient 1 is left out.
   const reports::BuiltReport& report = built();
