@@ -12,6 +12,7 @@
 #include <map>
 #include <regex>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace backlash::reports {
 
@@ -42,24 +43,34 @@ std::string roman_to_anchor(const std::string& id) {
 }
 
 std::string readable(const std::string& text) {
-  // (pattern, replacement), in order: the longer identifiers first
-  static const std::vector<std::pair<std::regex, std::string>> rules = [] {
-    const char* table[][2] = {{"\\btheta_([mLo]) dot\\b", "θ̇$1"},  {"\\bthetadot_([mLo])\\b", "θ̇$1"},
-                              {"\\bthetadot\\b", "θ̇"},               {"\\bdtheta_([mLo]0)\\b", "θ̇$1"},
-                              {"\\bdtheta_([mLo])\\b", "θ̇$1"},       {"\\bdtheta\\b", "θ̇"},
-                              {"\\btheta_([mLo]0)\\b", "θ$1"},      {"\\btheta_([mLoR])\\b", "θ$1"},
-                              {"\\bomega_([cm])\\b", "ω$1"},          {"\\bomega\\b", "ω"},
-                              {"\\beta([0-9]?)\\b", "η$1"},           {"\\bTable([0-9]+)\\b", "Table $1"},
-                              {"\\bEq([0-9]+)\\b", "eq. $1"},         {"\\bSection([0-9]+)\\b", "section $1"},
-                              // a test's name, Suite.Name, split where a line may break
-                              {"\\b([A-Za-z0-9]+_[A-Za-z0-9_]+)\\.([A-Z][A-Za-z0-9]+)\\b", "$1 / $2"}};
-    std::vector<std::pair<std::regex, std::string>> out;
-    for (const auto& rule : table) out.emplace_back(std::regex(rule[0]), rule[1]);
-    return out;
-  }();
-  std::string out = text;
-  for (const auto& [pattern, replacement] : rules) out = std::regex_replace(out, pattern, replacement);
-  return out;
+  // One pass of one pattern over the text (the ledger's 600 causes are printed three times:
+  // on the case pages, the ledger page and the index), each result kept for the next time.
+  static const std::regex identifier(
+      R"(\b(d?)theta(?:_([mLoR])(0?)|dot(?:_([mLo]))?)?( dot)?\b|\bomega(?:_([cm]))?\b|\beta([0-9]?)\b|\b(Table|Eq|Section)([0-9]+)\b|\b([A-Za-z0-9]+_[A-Za-z0-9_]+)\.([A-Z][A-Za-z0-9]+)\b)");
+  static std::unordered_map<std::string, std::string> done;
+  const auto found = done.find(text);
+  if (found != done.end()) return found->second;
+  std::string out;
+  std::size_t from = 0;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), identifier); it != std::sregex_iterator(); ++it) {
+    const std::smatch& m = *it;
+    out += text.substr(from, static_cast<std::size_t>(m.position()) - from);
+    from = static_cast<std::size_t>(m.position() + m.length());
+    if (m[10].matched) {  // a test's name, Suite.Name: split where a line may break
+      out += m[10].str() + " / " + m[11].str();
+    } else if (m[8].matched) {  // Table20, Eq38, Section14
+      out += (m[8].str() == "Table" ? "Table " : m[8].str() == "Eq" ? "eq. " : "section ") + m[9].str();
+    } else if (m[7].matched) {  // eta, eta2
+      out += "η" + m[7].str();
+    } else if (m.str().rfind("omega", 0) == 0) {  // omega, omega_c
+      out += "ω" + m[6].str();
+    } else {  // theta_m, dtheta_m0, theta_L dot, thetadot, thetadot_o
+      const bool dotted = m[1].length() > 0 || m[5].matched || m.str().find("thetadot") != std::string::npos;
+      out += std::string(dotted ? "θ̇" : "θ") + m[2].str() + m[3].str() + m[4].str();
+    }
+  }
+  out += text.substr(from);
+  return done.emplace(text, out).first->second;
 }
 
 const ThesisCase& ThesisData::thesis_case(const std::string& id) const {

@@ -134,6 +134,8 @@ TEST(CasePages, ProseNamesQuantitiesAsAReaderWould) {
   const std::regex raw(R"(\b(d?theta(\\?_[mLoR]0?)?|thetadot\w*|omega\\?_\w+)\b|\b(Table|Eq|Section)[0-9]+\b(?!\\?_)|cycle\(s\))");
   for (const auto& [path, content] : report.files) {
     if (path.size() < 3 || path.compare(path.size() - 3, 3, ".md") != 0) continue;
+    // the exact checks' formulas as mathematics, not as their ASCII names in code
+    EXPECT_EQ(content.find("passed: `"), std::string::npos) << path << ": a check printed as code";
     const std::string text = prose(content);
     std::smatch m;
     EXPECT_FALSE(std::regex_search(text, m, raw))
