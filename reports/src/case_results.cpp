@@ -427,6 +427,7 @@ Plot separation_plot(const CaseResult& c, const FigureSpec& spec) {
   }
   plot.series.push_back(m);
   plot.series.push_back(l);
+  plot.x_range = std::pair{0.0, t_end};
   const numeric::DividingLinePoint at = numeric::dividing_line_point(c.evaluator(), v);
   if (at.status == numeric::RecombinationStatus::Recombination && at.t <= t_end) {
     plot.series.push_back({"recombination (gap = b) at t = " + fixed(at.t, 4), {at.t, at.t}, {at.theta_m - p.theta_R, at.theta_L - p.theta_R},
@@ -657,6 +658,12 @@ std::vector<Plot> sweep_figures(const std::vector<SweepResult>& sweeps, const st
     // room on the right for the case labels of the points at the end of the sweep
     const double x0 = sweep.rows.front().point.x, x1 = sweep.rows.back().point.x;
     plot.x_range = std::pair{std::min(0.0, x0), x1 + 0.1 * (x1 - std::min(0.0, x0))};
+    // and above and below every curve and point, so no case label sits on the frame
+    double lo = INFINITY, hi = -INFINITY;
+    for (const Series& s : plot.series)
+      for (double y : s.y)
+        if (std::isfinite(y)) lo = std::min(lo, y), hi = std::max(hi, y);
+    if (lo < hi) plot.y_range = std::pair{lo - 0.06 * (hi - lo), hi + 0.06 * (hi - lo)};
     plots.push_back(plot);
   }
   return plots;

@@ -341,7 +341,8 @@ BuiltReport build_report(const DataPaths& paths) {
                   "case with the same total inertia, friction, gain and backlash, whatever their split between motor and load; "
                   "the exact cycles differ.")));
     index.push_back(doc::heading(2, doc::text("Pages and files")));
-    index.push_back(doc::list({doc::link("general solutions", "general.md") + doc::text(": the 14 pole-structure branches (sections 3–5)"),
+    index.push_back(doc::list({doc::link("general solutions", "general.md") +
+                                   doc::text(": the " + std::to_string(branches.size()) + " pole-structure branches (sections 3–5)"),
                                doc::link("errata ledger", "errata.md") + doc::text(": every printed number that differs, with its cause"),
                                doc::text("report.pdf: all of it as one document (when pdflatex is installed)"),
                                doc::text("derivations/CASE.json, .tex; validation/CASE.json; dividing_lines/CASE.csv; "
