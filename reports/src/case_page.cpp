@@ -437,7 +437,11 @@ doc::Document case_document(const CaseResult& c, const ThesisData& data) {
     for (const numeric::StateError& s : report.states) {
       const std::string where = s.contact ? "θo0 = " + sig(s.at_theta_o0, 4) + ", θ̇o0 = " + sig(s.at_dtheta_o0, 4)
                                           : "θ̇m0 = " + sig(s.at_dtheta_m0, 4);
-      rows.push_back({doc::code(s.state), doc::text(sig(s.max_abs_error, 3)), doc::text(fixed(s.at_t, 3)), doc::text(where),
+      // the evaluator's state by its quantity (its name in the JSON is the code's: theta_m, gap, cot_phi)
+      const Rich state = s.state == "gap"       ? doc::math("\\theta_L - \\theta_m") + doc::text(" (the gap)")
+                         : s.state == "cot_phi" ? doc::math("\\cot\\varphi")
+                                                : doc::math(latex_quantity(s.state));
+      rows.push_back({state, doc::text(sig(s.max_abs_error, 3)), doc::text(fixed(s.at_t, 3)), doc::text(where),
                       doc::text(std::to_string(s.samples)), doc::text(s.passed ? "pass" : "FAIL")});
     }
     out.push_back(doc::table({doc::text("state"), doc::text("max |error|"), doc::text("at t (s)"), doc::text("from"),

@@ -425,7 +425,10 @@ doc::Document segment_blocks(const SegmentView& v, const CaseParameters& p, cons
   doc::Document out;
   out.push_back(doc::heading(level, v.title));
   if (!v.transformed_equation.empty()) {
-    out.push_back(doc::paragraph(doc::text("The Laplace transform of the equation of motion with its initial state:")));
+    // a velocity's transform comes from its position's by the derivative rule, not from an equation of motion
+    const bool velocity = v.key[0] == 'd';
+    out.push_back(doc::paragraph(doc::text(velocity ? "The transform of the velocity, by the derivative rule from the position's:"
+                                                    : "The Laplace transform of the equation of motion with its initial state:")));
     out.push_back(doc::equation(v.transformed_equation));
   }
   SegmentSteps steps;
