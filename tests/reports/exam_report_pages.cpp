@@ -179,6 +179,20 @@ TEST(CasePages, CoefficientsOfOneAreNotPrinted) {
   }
 }
 
+TEST(CasePages, TheCodeExcerptReadsTheSameInThePdf) {
+  // LaTeX's verbatim takes ASCII only: the excerpt's "θm(t)" must not become "??m(t)".
+  const reports::BuiltReport& report = built();
+  const std::string& tex = report.latex_document;
+  int blocks = 0;
+  for (std::size_t at = tex.find("\\begin{verbatim}"); at != std::string::npos; at = tex.find("\\begin{verbatim}", at + 1)) {
+    const std::string block = tex.substr(at, tex.find("\\end{verbatim}", at) - at);
+    EXPECT_EQ(block.find('?'), std::string::npos) << "returned an unprintable character in " << block.substr(0, 200);
+    EXPECT_NE(block.find("theta_m(t)"), std::string::npos) << "the excerpt's comment lost its θm(t): " << block.substr(0, 200);
+    ++blocks;
+  }
+  EXPECT_EQ(blocks, 8) << "returned " << blocks << " code excerpts instead of one per case";
+}
+
 TEST(ErrataLedger, ExactValuesAreMathematicsNotGinacText) {
   // The ledger's closed forms ("-180*atan(5/54)*Pi^(-1)") are printed as formulas.
   const reports::BuiltReport& report = built();
