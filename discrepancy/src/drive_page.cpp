@@ -4,6 +4,7 @@
 #include "backlash/discrepancy/measured_drive.hpp"
 
 #include "internal.hpp"
+#include "page_json.hpp"
 #include "plots.hpp"
 
 #include <nlohmann/json.hpp>
@@ -27,34 +28,10 @@ using detail::bar_chart;
 using detail::line_plot;
 using detail::number;
 
-nlohmann::json json_number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
-nlohmann::json values_json(const std::vector<Parameter>& ps) {
-  nlohmann::json out = nlohmann::json::object();
-  for (const Parameter& p : ps) out[p.name] = json_number(p.value);
-  return out;
-}
-
-nlohmann::json sigmas_json(const std::vector<Parameter>& ps) {
-  nlohmann::json out = nlohmann::json::object();
-  for (const Parameter& p : ps) out[p.name] = json_number(p.uncertainty);
-  return out;
-}
-
-nlohmann::json candidate_json(const Candidate& c) {
-  return {{"effect", c.effect},
-          {"parameters", values_json(c.parameters)},
-          {"rms", json_number(c.rms)},
-          {"rms_fit", json_number(c.rms_fit)},
-          {"rms_holdout", json_number(c.rms_holdout)},
-          {"bic", json_number(c.bic)},
-          {"delta_bic", json_number(c.delta_bic)},
-          {"score", json_number(c.delta_bic)},
-          {"decisive", c.decisive},
-          {"at_range_edge", c.at_range_edge},
-          {"least_squares", c.simulations},
-          {"failure", c.failure}};
-}
+using detail::effects_json;
+using detail::json_number;
+using detail::parameter_values_json;
+using detail::rounds_json;
 
 nlohmann::json region_json(const TorqueRegion& g) {
   nlohmann::json out{{"kind", g.kind},         {"samples", g.samples},         {"rms", g.rms_before},
@@ -127,21 +104,8 @@ std::pair<std::vector<double>, std::vector<double>> binned_mean(const std::vecto
 }  // namespace
 
 std::string drive_to_json(const model::CaseSpec& model, const DriveDiscrepancyResult& r) {
-  nlohmann::json candidates = nlohmann::json::array(), rounds = nlohmann::json::array();
-  for (std::size_t k = 0; k < r.rounds.size(); ++k) {
-    nlohmann::json round = nlohmann::json::array();
-    for (const Candidate& c : r.rounds[k]) {
-      round.push_back(candidate_json(c));
-      if (k == 0) candidates.push_back(candidate_json(c));
-    }
-    rounds.push_back(round);
-  }
-  nlohmann::json effects = nlohmann::json::array();
-  for (const Candidate& c : r.effects)
-    effects.push_back({{"effect", c.effect},
-                       {"parameters", values_json(c.parameters)},
-                       {"uncertainty", sigmas_json(c.parameters)},
-                       {"delta_bic", json_number(c.delta_bic)}});
+  const detail::RoundsJson rounds = rounds_json(r.rounds, "least_squares");
+  const nlohmann::json effects = effects_json(r.effects);
   nlohmann::json regions = nlohmann::json::array(), classes = nlohmann::json::array();
   for (const TorqueRegion& g : r.stretches) regions.push_back(region_json(g));
   for (const TorqueRegion& g : r.classes) classes.push_back(region_json(g));
@@ -155,7 +119,7 @@ std::string drive_to_json(const model::CaseSpec& model, const DriveDiscrepancyRe
       {"experiment", "drive"},
       {"status", to_string(r.status)},
       {"effect", found ? nlohmann::json(r.effects.front().effect) : nlohmann::json(nullptr)},
-      {"parameters", found ? values_json(r.effects.front().parameters) : nlohmann::json(nullptr)},
+      {"parameters", found ? parameter_values_json(r.effects.front().parameters) : nlohmann::json(nullptr)},
       {"effects", effects},
       {"rms_before", r.rms_before},
       {"rms_after", r.rms_after},
@@ -172,8 +136,8 @@ std::string drive_to_json(const model::CaseSpec& model, const DriveDiscrepancyRe
       {"tau_int", {{"before", r.tau_int_before}, {"after", r.tau_int_after}}},
       {"nominal", {{"given", parameters_json(r.given)}, {"fitted", fitted}, {"parameters", parameters_json(r.nominal)}}},
       {"corrected", {{"parameters", parameters_json(r.parameters)}, {"refitted", refitted}, {"effects", r.corrected_effects.describe()}}},
-      {"candidates", candidates},
-      {"rounds", rounds},
+      {"candidates", rounds.candidates},
+      {"rounds", rounds.rounds},
       {"regions", regions},
       {"classes", classes},
       {"estimation", scores_json(r.estimation)},
@@ -236,8 +200,8 @@ std::vector<std::pair<std::string, std::string>> drive_report_files(const model:
     scatter.push_back({"corrected, mean", "#175", &va, &mean_after});
   }
   files.push_back({"torque_residual_vs_velocity.svg",
-                   line_plot("Torque residual (measured drive − model's inverse dynamics) against velocity", "velocity",
-                             "torque residual", scatter, {}, {{0.0, "zero"}})});
+                   line_plot("Torque residual (measured drive − model's inverse dynamics) against velocity", "velocity [m/s]",
+                             "force residual [N]", scatter, {}, {{0.0, "zero"}})});
   // Torque over time and position over windows: the stretch around the nominal model's worst window.
   const auto range = worst_windows(r.t, r.position, r.position_nominal, r.window_starts, 3);
   const std::vector<double> t = slice(r.t, range), measured = slice(r.torque_measured, range),
@@ -246,7 +210,7 @@ std::vector<std::pair<std::string, std::string>> drive_report_files(const model:
                              {"nominal needs", "#c33", &t, &nominal, true}};
   if (found) torque.push_back({"corrected needs", "#2a7", &t, &corrected});
   files.push_back({"torque_over_time.svg", line_plot("Drive torque: measured, and what each model needs along the measured motion",
-                                                     "t [s]", "torque", torque)});
+                                                     "t [s]", "drive force [N]", torque)});
   const std::vector<double> q = slice(r.position, range), qn = slice(r.position_nominal, range),
                             qc = slice(r.position_corrected, range);
   std::vector<Series> position{{"measured", "#222", &t, &q}, {"nominal", "#c33", &t, &qn, true}};
@@ -256,7 +220,7 @@ std::vector<std::pair<std::string, std::string>> drive_report_files(const model:
     windows.push_back({r.window_starts[w], w + 1 < r.window_starts.size() ? r.window_starts[w + 1] : r.t.back(), "#9ab"});
   files.push_back({"position_window.svg",
                    line_plot("Position predicted over windows restarted from the measured state (shading: every other window)",
-                             "t [s]", "position", position, windows)});
+                             "t [s]", "position [m]", position, windows)});
   if (r.validation) {
     const auto range_v = worst_windows(r.validation_t, r.validation_position, r.validation_nominal, r.validation_window_starts, 3);
     const std::vector<double> tv = slice(r.validation_t, range_v), qv = slice(r.validation_position, range_v),
@@ -264,7 +228,7 @@ std::vector<std::pair<std::string, std::string>> drive_report_files(const model:
     std::vector<Series> vp{{"measured", "#222", &tv, &qv}, {"nominal", "#c33", &tv, &qvn, true}};
     if (found) vp.push_back({"corrected", "#2a7", &tv, &qvc});
     files.push_back({"validation_position_window.svg",
-                     line_plot("Validation record (not fitted): position predicted over windows", "t [s]", "position", vp)});
+                     line_plot("Validation record (not fitted): position predicted over windows", "t [s]", "position [m]", vp)});
   }
   std::vector<std::pair<std::string, double>> bars;
   if (!r.rounds.empty())
@@ -288,6 +252,8 @@ std::vector<std::pair<std::string, std::string>> drive_report_files(const model:
   md << "Noise: position σ = " << number(r.position_noise) << ", drive σ = " << number(r.drive_noise)
      << "; propagated through the filter and the derivatives, the torque residual's noise level is " << number(r.noise)
      << ". At rest: |velocity| < " << number(r.rest_speed) << ".\n\n";
+  md << "Units are the record's own (SI); the figures label them for a linear drive such as EMPS: position in m, velocity "
+        "in m/s, the drive and its residual (the workflow's \"torque\") in N; for a rotary record read rad, rad/s and N·m.\n\n";
   if (!r.nominal_fit.empty()) {
     md << "## The best nominal model\n\nThe parameters the model file marks free are fitted first (torque domain, whole record):\n\n"
        << "| parameter | given | fitted | ± (1σ) |\n|---|---|---|---|\n";

@@ -2,6 +2,7 @@
 // its figures (SVG drawn here, deterministically: the same result gives the same
 // bytes), and the corrected case file.
 #include "internal.hpp"
+#include "page_json.hpp"
 #include "plots.hpp"
 
 #include <nlohmann/json.hpp>
@@ -24,19 +25,9 @@ using detail::number;
 
 // ------------------------------------------------------------------ JSON
 
-nlohmann::json json_number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
-
-nlohmann::json parameters_json(const std::vector<Parameter>& ps) {
-  nlohmann::json out = nlohmann::json::object();
-  for (const Parameter& p : ps) out[p.name] = json_number(p.value);
-  return out;
-}
-
-nlohmann::json uncertainty_json(const std::vector<Parameter>& ps) {
-  nlohmann::json out = nlohmann::json::object();
-  for (const Parameter& p : ps) out[p.name] = json_number(p.uncertainty);
-  return out;
-}
+using detail::effects_json;
+using detail::json_number;
+using detail::rounds_json;
 
 nlohmann::json features_json(const Features& f) {
   return {{"overshoot", json_number(f.overshoot)},           {"final_error", json_number(f.final_error)},
@@ -53,33 +44,8 @@ nlohmann::json events_json(const std::vector<numeric::SimulationEvent>& events) 
 }  // namespace
 
 std::string to_json(const model::CaseSpec& model, const DiscrepancyResult& r, double step) {
-  nlohmann::json candidates = nlohmann::json::array(), rounds = nlohmann::json::array();
-  for (std::size_t k = 0; k < r.rounds.size(); ++k) {
-    nlohmann::json round = nlohmann::json::array();
-    for (const Candidate& c : r.rounds[k]) {
-      nlohmann::json item{{"effect", c.effect},
-                          {"parameters", parameters_json(c.parameters)},
-                          {"rms", json_number(c.rms)},
-                          {"rms_fit", json_number(c.rms_fit)},
-                          {"rms_holdout", json_number(c.rms_holdout)},
-                          {"bic", json_number(c.bic)},
-                          {"delta_bic", json_number(c.delta_bic)},
-                          {"score", json_number(c.delta_bic)},
-                          {"decisive", c.decisive},
-                          {"at_range_edge", c.at_range_edge},
-                          {"simulations", c.simulations},
-                          {"failure", c.failure}};
-      round.push_back(item);
-      if (k == 0) candidates.push_back(item);
-    }
-    rounds.push_back(round);
-  }
-  nlohmann::json effects = nlohmann::json::array();
-  for (const Candidate& c : r.effects)
-    effects.push_back({{"effect", c.effect},
-                       {"parameters", parameters_json(c.parameters)},
-                       {"uncertainty", uncertainty_json(c.parameters)},
-                       {"delta_bic", json_number(c.delta_bic)}});
+  const detail::RoundsJson rounds = rounds_json(r.rounds, "simulations");
+  const nlohmann::json effects = effects_json(r.effects);
   nlohmann::json regions = nlohmann::json::array();
   for (const Region& g : r.regions)
     regions.push_back({{"t_start", g.t_start},
@@ -93,7 +59,7 @@ std::string to_json(const model::CaseSpec& model, const DiscrepancyResult& r, do
                      {"step", step},
                      {"status", to_string(r.status)},
                      {"effect", found ? nlohmann::json(r.effects.front().effect) : nlohmann::json(nullptr)},
-                     {"parameters", found ? parameters_json(r.effects.front().parameters) : nlohmann::json(nullptr)},
+                     {"parameters", found ? detail::parameter_values_json(r.effects.front().parameters) : nlohmann::json(nullptr)},
                      {"effects", effects},
                      {"rms_before", r.rms_before},
                      {"rms_after", r.rms_after},
@@ -101,8 +67,8 @@ std::string to_json(const model::CaseSpec& model, const DiscrepancyResult& r, do
                      {"gap_before", r.gap_before},
                      {"gap_after", r.gap_after},
                      {"first_departure", json_number(r.first_departure)},
-                     {"candidates", candidates},
-                     {"rounds", rounds},
+                     {"candidates", rounds.candidates},
+                     {"rounds", rounds.rounds},
                      {"regions", regions},
                      {"features",
                       {{"measured", features_json(r.measured)},

@@ -65,8 +65,8 @@ int table_number(const std::string& table) { return std::atoi(table.c_str() + 5)
 struct Footnotes {
   std::vector<Rich> items;
   Rich cite(const Erratum& e, const std::string& what) {
-    items.push_back(doc::text("[" + std::to_string(items.size() + 1) + "] " + what + ": printed " + e.printed + ", exact " +
-                              (e.exact_decimal.empty() ? e.exact : e.exact_decimal) + ". " + e.cause));
+    items.push_back(doc::text("[" + std::to_string(items.size() + 1) + "] " + readable(what) + ": printed " + e.printed + ", exact " +
+                              (e.exact_decimal.empty() ? e.exact : e.exact_decimal) + ". " + readable(e.cause)));
     return doc::text("erratum [" + std::to_string(items.size()) + "]");
   }
 };
@@ -262,7 +262,7 @@ doc::Document case_document(const CaseResult& c, const ThesisData& data) {
                       agreement_cell(value, sp.printed, e, sp.table + ", " + quantity, notes)});
     }
     if (!rows.empty()) {
-      out.push_back(doc::paragraph(doc::text("Beside the thesis's " + table_name +
+      out.push_back(doc::paragraph(doc::text("Beside the thesis's " + readable(table_name) +
                                              " (read off its phase portrait; θL in the thesis's frame, measured from the face "
                                              "left at the separation):")));
       doc::Block t = doc::table({doc::text("t (s)"), doc::text("quantity"), doc::text("thesis"), doc::text("exact"), doc::text("digit agreement")},
@@ -276,7 +276,9 @@ doc::Document case_document(const CaseResult& c, const ThesisData& data) {
     std::vector<Rich> items;
     for (const Erratum& e : data.errata)
       if (e.case_id == c.spec.id && e.file == "step_responses.toml" && e.quantity.find(" at t=") == std::string::npos)
-        items.push_back(notes.cite(e, e.where + ", " + e.quantity));
+        items.push_back(doc::text(readable(e.where + ", " + e.quantity) + ": printed " + e.printed + ", exact " +
+                                  (e.exact_decimal.empty() ? e.exact : e.exact_decimal) + " (") +
+                        notes.cite(e, e.where + ", " + e.quantity) + doc::text(")"));
     if (!items.empty()) {
       out.push_back(doc::paragraph(doc::text("The thesis's other step-response numbers that differ from the exact ones:")));
       out.push_back(doc::list(items));
@@ -318,7 +320,8 @@ doc::Document case_document(const CaseResult& c, const ThesisData& data) {
     out.push_back(doc::paragraph(doc::text("The fixed point of the half-cycle return map on the separation line (exact hybrid "
                                            "simulation, refined by toms748):")));
     out.push_back(doc::table({doc::text("quantity"), doc::text("exact"), doc::text("thesis"), doc::text("")}, rows, "lrrl"));
-    if (magnitude_erratum) out.push_back(doc::paragraph(doc::text("Erratum (section 14): ") + doc::text(magnitude_erratum->cause + ".")));
+    if (magnitude_erratum)
+      out.push_back(doc::paragraph(doc::text("Erratum (section 14): ") + doc::text(readable(magnitude_erratum->cause) + ".")));
     if (!lc.other_fixed_points.empty()) {
       std::string list;
       for (double v : lc.other_fixed_points) list += (list.empty() ? "" : ", ") + sig(v, 6);
@@ -350,9 +353,9 @@ doc::Document case_document(const CaseResult& c, const ThesisData& data) {
       std::string equation = "C_{\\text{" + std::string(separation ? "separation" : "recombination") + "}} = " + e.exact_decimal +
                              "\\quad(\\text{printed } " + e.printed + ")";
       if (slot != tc.slots.end()) equation += " \\tag{" + slot->second + "}";
-      out.push_back(doc::paragraph(doc::text("Eq. 38 at the thesis's point (" + e.where + ", " + e.quantity + "):")));
+      out.push_back(doc::paragraph(doc::text("Eq. 38 at the thesis's point (" + readable(e.where + ", " + e.quantity) + "):")));
       out.push_back(doc::equation(equation));
-      out.push_back(doc::paragraph(doc::text(e.cause + ".")));
+      out.push_back(doc::paragraph(doc::text(readable(e.cause) + ".")));
     }
   }
 
@@ -397,8 +400,8 @@ doc::Document case_document(const CaseResult& c, const ThesisData& data) {
       std::size_t unstable = 0;
       for (const DescribingFunctionCycle& cycle : df.cycles) unstable += cycle.stable ? 0 : 1;
       if (unstable && c.cycle.other_fixed_points.empty())
-        verdict += "  It also predicts " + std::to_string(unstable) +
-                   " unstable cycle(s) that do not exist: the exact return map has no other fixed point in the searched range of "
+        verdict += "  It also predicts " + (unstable == 1 ? std::string("an unstable cycle that does") : std::to_string(unstable) +
+                   " unstable cycles that do") + " not exist: the exact return map has no other fixed point in the searched range of "
                    "separation velocities.";
       out.push_back(doc::paragraph(doc::bold("Verdict:") + doc::text(" " + verdict)));
     } else if (predicted) {
@@ -434,7 +437,11 @@ doc::Document case_document(const CaseResult& c, const ThesisData& data) {
     for (const numeric::StateError& s : report.states) {
       const std::string where = s.contact ? "θo0 = " + sig(s.at_theta_o0, 4) + ", θ̇o0 = " + sig(s.at_dtheta_o0, 4)
                                           : "θ̇m0 = " + sig(s.at_dtheta_m0, 4);
-      rows.push_back({doc::code(s.state), doc::text(sig(s.max_abs_error, 3)), doc::text(fixed(s.at_t, 3)), doc::text(where),
+      // the evaluator's state by its quantity (its name in the JSON is the code's: theta_m, gap, cot_phi)
+      const Rich state = s.state == "gap"       ? doc::math("\\theta_L - \\theta_m") + doc::text(" (the gap)")
+                         : s.state == "cot_phi" ? doc::math("\\cot\\varphi")
+                                                : doc::math(latex_quantity(s.state));
+      rows.push_back({state, doc::text(sig(s.max_abs_error, 3)), doc::text(fixed(s.at_t, 3)), doc::text(where),
                       doc::text(std::to_string(s.samples)), doc::text(s.passed ? "pass" : "FAIL")});
     }
     out.push_back(doc::table({doc::text("state"), doc::text("max |error|"), doc::text("at t (s)"), doc::text("from"),

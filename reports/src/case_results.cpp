@@ -10,7 +10,9 @@
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <regex>
 #include <stdexcept>
+#include <unordered_map>
 
 namespace backlash::reports {
 
@@ -38,6 +40,37 @@ std::string roman_to_anchor(const std::string& id) {
   std::string out = "case-";
   for (char c : id) out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return out;
+}
+
+std::string readable(const std::string& text) {
+  // One pass of one pattern over the text (the ledger's 600 causes are printed three times:
+  // on the case pages, the ledger page and the index), each result kept for the next time.
+  static const std::regex identifier(
+      R"(\b(d?)theta(?:_([mLoR])(0?)|dot(?:_([mLo]))?)?( dot)?\b|\bomega(?:_([cm]))?\b|\beta([0-9]?)\b|\b(Table|Eq|Section)([0-9]+)\b|\b([A-Za-z0-9]+_[A-Za-z0-9_]+)\.([A-Z][A-Za-z0-9]+)\b)");
+  static std::unordered_map<std::string, std::string> done;
+  const auto found = done.find(text);
+  if (found != done.end()) return found->second;
+  std::string out;
+  std::size_t from = 0;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), identifier); it != std::sregex_iterator(); ++it) {
+    const std::smatch& m = *it;
+    out += text.substr(from, static_cast<std::size_t>(m.position()) - from);
+    from = static_cast<std::size_t>(m.position() + m.length());
+    if (m[10].matched) {  // a test's name, Suite.Name: split where a line may break
+      out += m[10].str() + " / " + m[11].str();
+    } else if (m[8].matched) {  // Table20, Eq38, Section14
+      out += (m[8].str() == "Table" ? "Table " : m[8].str() == "Eq" ? "eq. " : "section ") + m[9].str();
+    } else if (m[7].matched) {  // eta, eta2
+      out += "η" + m[7].str();
+    } else if (m.str().rfind("omega", 0) == 0) {  // omega, omega_c
+      out += "ω" + m[6].str();
+    } else {  // theta_m, dtheta_m0, theta_L dot, thetadot, thetadot_o
+      const bool dotted = m[1].length() > 0 || m[5].matched || m.str().find("thetadot") != std::string::npos;
+      out += std::string(dotted ? "θ̇" : "θ") + m[2].str() + m[3].str() + m[4].str();
+    }
+  }
+  out += text.substr(from);
+  return done.emplace(text, out).first->second;
 }
 
 const ThesisCase& ThesisData::thesis_case(const std::string& id) const {
@@ -281,7 +314,8 @@ Plot phase_plot(const CaseResult& c, const FigureSpec& spec) {
       const bool upper = by > ay || (by == ay && bx > ax);
       const double lx = upper ? bx : ax, ly = upper ? by : ay;
       const std::string text = row.is_infinite ? "η=∞" : "η=" + symbolic::pretty::decimal(eta, 4, symbolic::pretty::Style::Text);
-      const double x = theta_R + 0.9 * (lx - theta_R), y = 0.9 * ly;
+      // (left-aligned text: kept clear of the right edge of the frame)
+      const double x = std::min(theta_R + 0.9 * (lx - theta_R), w.x1 - 0.06 * (w.x1 - w.x0)), y = 0.9 * ly;
       bool crowded = false;
       for (const Label& other : plot.labels)
         crowded = crowded || (std::fabs(other.x - x) < 0.07 * (w.x1 - w.x0) && std::fabs(other.y - y) < 0.04 * (w.y1 - w.y0));
@@ -347,6 +381,24 @@ Plot phase_plot(const CaseResult& c, const FigureSpec& spec) {
   return plot;
 }
 
+// A legend below the axes, two entries a row.
+const char* below_axes_key = "outside below center horizontal maxcols 2 samplen 2.5 font ',10'";
+
+// The vertical range of a divider figure: every divider level and every recombination read
+// off, and the two shafts up to the last of those readings, with a margin (later the
+// open-loop motor runs far off and would squash the construction the figure is about).
+std::pair<double, double> divider_window(const Series& motor, const Series& load, const Series& levels, const Series& hits) {
+  double t_last = 0, lo = 0, hi = 0;
+  for (double t : hits.x) t_last = std::max(t_last, t);
+  for (double y : levels.y)
+    if (std::isfinite(y)) hi = std::max(hi, y);
+  for (const Series* s : {&motor, &load})
+    for (std::size_t k = 0; k < s->x.size(); ++k)
+      if (s->x[k] <= t_last) lo = std::min(lo, s->y[k]), hi = std::max(hi, s->y[k]);
+  const double margin = 0.12 * (hi - lo);
+  return {lo - margin, hi + margin};
+}
+
 Plot separation_plot(const CaseResult& c, const FigureSpec& spec) {
   const numeric::Parameters& p = c.parameters;
   const double v = printed_number(spec.dtheta_m0), t_end = printed_number(spec.t_end);
@@ -355,7 +407,9 @@ Plot separation_plot(const CaseResult& c, const FigureSpec& spec) {
   const std::string v_text = sig(v, 6);
   plot.title = "Thesis fig. " + std::to_string(spec.number) + ": case " + c.spec.id + ", θ_{m} and θ_{L} during separation (θ̇_{m0} = " + v_text + ")";
   plot.x_label = "t, time since the separation (s)";
-  plot.key = "inside left top font ',10'";
+  // the legend below the axes: inside, the curves of one case or another run through it
+  plot.key = below_axes_key;
+  plot.height = 760;
   plot.y_label = "displacement from θ_{R} (rad)";
   Series m{"θ_{m} − θ_{R}, motor", {}, {}, std::string("lines lw 2 lc rgb '") + color_motor + "'"};
   Series l{"θ_{L} − θ_{R}, load", {}, {}, std::string("lines lw 2 lc rgb '") + color_load + "'"};
@@ -373,6 +427,7 @@ Plot separation_plot(const CaseResult& c, const FigureSpec& spec) {
   }
   plot.series.push_back(m);
   plot.series.push_back(l);
+  plot.x_range = std::pair{0.0, t_end};
   const numeric::DividingLinePoint at = numeric::dividing_line_point(c.evaluator(), v);
   if (at.status == numeric::RecombinationStatus::Recombination && at.t <= t_end) {
     plot.series.push_back({"recombination (gap = b) at t = " + fixed(at.t, 4), {at.t, at.t}, {at.theta_m - p.theta_R, at.theta_L - p.theta_R},
@@ -397,6 +452,7 @@ Plot separation_plot(const CaseResult& c, const FigureSpec& spec) {
     }
     plot.series.push_back(levels);
     if (!hits.x.empty()) plot.series.push_back(hits);
+    plot.y_range = divider_window(m, l, levels, hits);
   }
   return plot;
 }
@@ -423,7 +479,8 @@ Plot transient_plot(const CaseResult& c, const FigureSpec* spec, const ThesisDat
   }
   plot.x_label = "t (s)";
   plot.y_label = "θ_{o} − θ_{o}(0), displacement from the start (rad)";
-  plot.key = "bottom right";
+  plot.key = below_axes_key;  // inside, the oscillating responses run through it
+  plot.height = 760;
   double t_max = 0;
   std::vector<const TrajectoryRun*> runs;
   if (spec) {
@@ -442,8 +499,8 @@ Plot transient_plot(const CaseResult& c, const FigureSpec* spec, const ThesisDat
     Series main{"", {}, {}, "points pt 6 ps 1.3 lc rgb '#000000'"}, load{"", {}, {}, "points pt 4 ps 1.3 lc rgb '#2a9d3a'"};
     for (const StepPoint& sp : data.step_points) {
       if (sp.case_id != c.spec.id || std::fabs(printed_number(sp.step) - run->step) > 1e-12) continue;
-      main.label = sp.table + " (printed): θ_{o}, θ_{m}";
-      load.label = sp.table + " (printed): θ_{L}, thesis's frame";
+      main.label = readable(sp.table) + " (printed): θ_{o}, θ_{m}";
+      load.label = readable(sp.table) + " (printed): θ_{L}, thesis's frame";
       const double t = printed_number(sp.t), y = printed_number(sp.printed);
       const double start = sp.quantity == "theta_o - theta_o(0)" ? 0.0 : (p.theta_R - run->step);
       t_max = std::max(t_max, t);
@@ -518,6 +575,26 @@ std::vector<SweepResult> compute_sweeps() {
 
 namespace {
 
+// A sweep's series name ("FL=0 Fm=.2", "JL=4Jm") in the figures' notation: "F_{L} = 0, F_{m} = .2".
+std::string readable_series(const std::string& name) {
+  std::string out;
+  for (std::size_t k = 0; k < name.size(); ++k) {
+    const char c = name[k];
+    const char next = k + 1 < name.size() ? name[k + 1] : '\0';
+    if ((c == 'J' || c == 'F') && (next == 'L' || next == 'm')) {
+      out += std::string(1, c) + "_{" + next + "}";
+      ++k;
+    } else if (c == '=') {
+      out += " = ";
+    } else if (c == ' ') {
+      out += ", ";
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 bool same_parameters(const numeric::Parameters& a, const numeric::Parameters& b) {
   const auto close = [](double x, double y) { return std::fabs(x - y) <= 1e-9 * std::max(1.0, std::fabs(y)); };
   return a.measured_at == b.measured_at && close(a.Jm, b.Jm) && close(a.Fm, b.Fm) && close(a.JL, b.JL) && close(a.FL, b.FL) &&
@@ -548,7 +625,7 @@ std::vector<Plot> sweep_figures(const std::vector<SweepResult>& sweeps, const st
     for (const numeric::SweepRow& row : sweep.rows) {
       if (!series.count(row.point.series)) {
         order.push_back(row.point.series);
-        series[row.point.series] = Series{"exact, " + row.point.series, {}, {}, ""};
+        series[row.point.series] = Series{"exact, " + readable_series(row.point.series), {}, {}, ""};
       }
       Series& s = series[row.point.series];
       s.x.push_back(row.point.x);
@@ -578,6 +655,15 @@ std::vector<Plot> sweep_figures(const std::vector<SweepResult>& sweeps, const st
       plot.series.push_back(thesis);
       plot.series.push_back(exact);
     }
+    // room on the right for the case labels of the points at the end of the sweep
+    const double x0 = sweep.rows.front().point.x, x1 = sweep.rows.back().point.x;
+    plot.x_range = std::pair{std::min(0.0, x0), x1 + 0.1 * (x1 - std::min(0.0, x0))};
+    // and above and below every curve and point, so no case label sits on the frame
+    double lo = INFINITY, hi = -INFINITY;
+    for (const Series& s : plot.series)
+      for (double y : s.y)
+        if (std::isfinite(y)) lo = std::min(lo, y), hi = std::max(hi, y);
+    if (lo < hi) plot.y_range = std::pair{lo - 0.06 * (hi - lo), hi + 0.06 * (hi - lo)};
     plots.push_back(plot);
   }
   return plots;

@@ -61,6 +61,28 @@ void fix_pdf_dates(const std::filesystem::path& file) {
   io.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
+// gnuplot splits enhanced text into <tspan>s ("θ_{m} and" gives "θ", "m", " and"), and
+// librsvg (and other SVG renderers) collapse the space that starts a tspan, even a
+// no-break space, unless the text element preserves white space: "θmand".  Every
+// <text> gets xml:space="preserve" (gnuplot writes no white space between the tspans).
+void preserve_svg_spaces(const std::filesystem::path& file) {
+  std::string bytes;
+  {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) return;
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::string plain = "<text>", kept = "<text xml:space=\"preserve\">";
+  std::size_t replaced = 0;
+  for (std::size_t at = bytes.find(plain); at != std::string::npos; at = bytes.find(plain, at + kept.size())) {
+    bytes.replace(at, plain.size(), kept);
+    ++replaced;
+  }
+  if (replaced == 0) return;
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
 }  // namespace
 
 bool has_data(const Plot& plot) {
@@ -190,7 +212,10 @@ std::optional<std::string> render_figures(const std::vector<Plot>& plots, const 
   fs::remove(script_file, ignored);
   fs::remove(log, ignored);
   if (!failure)
-    for (const Plot& plot : plots) fix_pdf_dates(directory / "figures" / (plot.name + ".pdf"));
+    for (const Plot& plot : plots) {
+      fix_pdf_dates(directory / "figures" / (plot.name + ".pdf"));
+      preserve_svg_spaces(directory / "figures" / (plot.name + ".svg"));
+    }
   return failure;
 }
 

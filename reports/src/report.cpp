@@ -43,6 +43,22 @@ std::string markdown(const doc::Document& d, const std::string& root) {
   return doc::to_markdown(d, o);
 }
 
+// The ledger's exact value as mathematics: its closed form (GiNaC syntax in the file,
+// "-180*atan(5/54)*Pi^(-1)") parsed and printed like every other formula, then its decimal.
+Rich exact_cell(const Erratum& e) {
+  if (e.exact.empty()) return doc::text(e.exact_decimal);
+  try {
+    GiNaC::symtab constants;
+    constants["Pi"] = GiNaC::Pi;
+    GiNaC::parser reader(constants, true);  // strict: a name that is not a constant is an error
+    const std::string closed = symbolic::pretty::latex(reader(e.exact));
+    return doc::math(e.exact_decimal.empty() ? closed : closed + " = " + e.exact_decimal);
+  } catch (const std::exception&) {
+    throw std::runtime_error("reports/errata/" + e.file + ": " + e.where + ", case " + e.case_id + ": exact = \"" + e.exact +
+                             "\" is not a closed form");
+  }
+}
+
 doc::Document errata_document(const std::vector<Erratum>& errata, int level) {
   doc::Document out;
   out.push_back(doc::paragraph(doc::text(
@@ -56,8 +72,9 @@ doc::Document errata_document(const std::vector<Erratum>& errata, int level) {
     doc::Block t = doc::table({doc::text("where"), doc::text("case"), doc::text("quantity"), doc::text("printed"), doc::text("exact"),
                                doc::text("likely cause")},
                               rows, "llllll");
-    t.latex_columns = ">{\\raggedright\\arraybackslash}p{1.3cm}p{0.7cm}>{\\raggedright\\arraybackslash}p{3.2cm}p{1.1cm}"
-                      ">{\\raggedright\\arraybackslash}p{2.3cm}>{\\raggedright\\arraybackslash}p{6.6cm}";
+    // 14.6 cm of columns and 12 column gaps (2.5 cm) inside the 17.4 cm text width
+    t.latex_columns = ">{\\raggedright\\arraybackslash}p{1.3cm}p{0.7cm}>{\\raggedright\\arraybackslash}p{2.9cm}p{1.0cm}"
+                      ">{\\raggedright\\arraybackslash}p{2.8cm}>{\\raggedright\\arraybackslash}p{5.9cm}";
     t.small = true;
     out.push_back(t);
     rows.clear();
@@ -70,9 +87,8 @@ doc::Document errata_document(const std::vector<Erratum>& errata, int level) {
       file = e.file;
       out.push_back(doc::heading(level, doc::text(file + " (" + std::to_string(counts[file]) + " entries)")));
     }
-    std::string exact = e.exact.empty() ? e.exact_decimal : (e.exact_decimal.empty() ? e.exact : e.exact + " = " + e.exact_decimal);
-    rows.push_back({doc::text(e.where), doc::text(e.case_id), doc::text(e.quantity), doc::text(e.printed), doc::code(exact),
-                    doc::text(e.cause)});
+    rows.push_back({doc::text(readable(e.where)), doc::text(e.case_id), doc::text(readable(e.quantity)), doc::text(e.printed),
+                    exact_cell(e), doc::text(readable(e.cause))});
   }
   flush();
   return out;
@@ -325,7 +341,8 @@ BuiltReport build_report(const DataPaths& paths) {
                   "case with the same total inertia, friction, gain and backlash, whatever their split between motor and load; "
                   "the exact cycles differ.")));
     index.push_back(doc::heading(2, doc::text("Pages and files")));
-    index.push_back(doc::list({doc::link("general solutions", "general.md") + doc::text(": the 14 pole-structure branches (sections 3–5)"),
+    index.push_back(doc::list({doc::link("general solutions", "general.md") +
+                                   doc::text(": the " + std::to_string(branches.size()) + " pole-structure branches (sections 3–5)"),
                                doc::link("errata ledger", "errata.md") + doc::text(": every printed number that differs, with its cause"),
                                doc::text("report.pdf: all of it as one document (when pdflatex is installed)"),
                                doc::text("derivations/CASE.json, .tex; validation/CASE.json; dividing_lines/CASE.csv; "

@@ -81,5 +81,9 @@ symbolic::doc::Document case_document(const CaseResult& c, const ThesisData& dat
 std::string fixed(double v, int decimals);
 std::string sig(double v, int significant = 6);
 std::string roman_to_anchor(const std::string& id);
+/// A data file's text as a reader's: the ledger's keys and causes name quantities as
+/// identifiers ("Table20", "dtheta_m0", "theta_L dot", "Eq38"); pages print "Table 20",
+/// "θ̇m0", "θ̇L", "eq. 38".
+std::string readable(const std::string& text);
 
 }  // namespace backlash::reports

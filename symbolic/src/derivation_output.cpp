@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <regex>
 #include <sstream>
 
 namespace backlash::symbolic {
@@ -304,6 +305,68 @@ std::string complex_latex(const ex& value, const RadicalList& radicals) {
 
 // The denominator as constant × its factors, a complex pair α ± iω written (s − α)² + ω²
 // and a real pair α ± δ as (s − α − δ)(s − α + δ), so the poles can be read off.
+// A check's formula, written in ASCII in its name ("Jm*theta_m'' + Fm*theta_m' = …"), in
+// the thesis's notation (J_m\ddot\theta_m + F_m\dot\theta_m = …), token by token.
+std::string check_formula_latex(const std::string& f) {
+  static const std::regex token(R"(L\^-1\[|d/dt |cot\(phi\)\*|(d?)([tT])heta(_[mLoR]0?)?('*)(\+?)|eta([12])|\b([JF])([mL])\b|\*|\+)");
+  std::string out;
+  std::size_t from = 0;
+  for (auto it = std::sregex_iterator(f.begin(), f.end(), token); it != std::sregex_iterator(); ++it) {
+    const std::smatch& m = *it;
+    out += f.substr(from, static_cast<std::size_t>(m.position()) - from);
+    from = static_cast<std::size_t>(m.position() + m.length());
+    const std::string t = m.str();
+    if (t == "L^-1[") out += "\\mathcal{L}^{-1}[";
+    else if (t == "d/dt ") out += "\\frac{d}{dt}";
+    else if (t == "cot(phi)*") out += "\\cot\\varphi\\,";
+    else if (t == "*") continue;
+    else if (t == "+") out += " + ";
+    else if (m[6].matched) out += "\\eta_" + m[6].str();
+    else if (m[7].matched) out += m[7].str() + "_" + m[8].str();
+    else {
+      const std::size_t dots = (m[1].length() > 0 ? 1 : 0) + static_cast<std::size_t>(m[4].length());
+      const std::string sub = m[3].str();
+      out += std::string(dots == 0 ? "" : dots == 1 ? "\\dot" : "\\ddot") + (m[2].str() == "T" ? "\\Theta" : "\\theta") +
+             (sub.size() > 2 ? "_{" + sub.substr(1) + "}" : sub) + (m[5].length() > 0 ? "^{+}" : "");
+    }
+  }
+  out += f.substr(from);
+  static const std::regex spaces(" +");
+  return std::regex_replace(out, spaces, " ");
+}
+
+// A verification check as the page prints it: its words as text, its formulas as
+// mathematics ("free motor: " + J_m\ddot\theta_m + … + " (eq. 39)").  The name itself
+// stays the check's identifier (JSON).
+Rich check_rich(const std::string& name) {
+  Rich out;
+  std::string body = name;
+  const auto colon = body.find(": ");
+  if (colon != std::string::npos) {
+    out = doc::text(body.substr(0, colon + 2));
+    body = body.substr(colon + 2);
+  }
+  std::string tail;
+  const std::regex trailing(R"(( \(eq\. [0-9]+\)| along .*)$)");
+  std::smatch m;
+  if (std::regex_search(body, m, trailing)) {
+    tail = m.str();
+    body = body.substr(0, static_cast<std::size_t>(m.position()));
+  }
+  // words between formulas: "… at t = 0 gives dtheta_m0", a label before a formula: "transmitted torque JL*…"
+  const std::regex words(R"( (at|gives) |^((?:[a-z-]+ )+)(?=[A-Za-z]+[0-9_*(]))");
+  std::size_t from = 0;
+  for (auto it = std::sregex_iterator(body.begin(), body.end(), words); it != std::sregex_iterator(); ++it) {
+    const std::size_t at = static_cast<std::size_t>(it->position());
+    if (at > from) out = out + doc::math(check_formula_latex(body.substr(from, at - from)));
+    out = out + doc::text(it->str());
+    from = at + static_cast<std::size_t>(it->length());
+  }
+  if (from < body.size()) out = out + doc::math(check_formula_latex(body.substr(from)));
+  if (!tail.empty()) out = out + doc::text(tail);
+  return out;
+}
+
 std::string factored_latex(const SegmentSteps& steps) {
   const symbol& s = derivation_symbols().s;
   ex constant = steps.leading_constant;
@@ -362,7 +425,10 @@ doc::Document segment_blocks(const SegmentView& v, const CaseParameters& p, cons
   doc::Document out;
   out.push_back(doc::heading(level, v.title));
   if (!v.transformed_equation.empty()) {
-    out.push_back(doc::paragraph(doc::text("The Laplace transform of the equation of motion with its initial state:")));
+    // a velocity's transform comes from its position's by the derivative rule, not from an equation of motion
+    const bool velocity = v.key[0] == 'd';
+    out.push_back(doc::paragraph(doc::text(velocity ? "The transform of the velocity, by the derivative rule from the position's:"
+                                                    : "The Laplace transform of the equation of motion with its initial state:")));
     out.push_back(doc::equation(v.transformed_equation));
   }
   SegmentSteps steps;
@@ -379,9 +445,17 @@ doc::Document segment_blocks(const SegmentView& v, const CaseParameters& p, cons
     out.push_back(doc::paragraph(doc::text("Solved for the transform, as one rational function in lowest terms:")));
     out.push_back(doc::equation(v.laplace_lhs + " = " + pp::print(steps.transform) +
                                 (tag(tags, v.key + "_transform").empty() ? "" : " \\tag{" + tag(tags, v.key + "_transform") + "}")));
-    out.push_back(doc::paragraph(doc::text("Its denominator factored:")));
-    out.push_back(doc::equation(pp::print(steps.transform.denominator) + " = " + factored_latex(steps) +
-                                (tag(tags, v.key + "_factored").empty() ? "" : " \\tag{" + tag(tags, v.key + "_factored") + "}")));
+    const std::string denominator = pp::print(steps.transform.denominator), factored = factored_latex(steps);
+    const std::string factored_tag = tag(tags, v.key + "_factored").empty() ? "" : " \\tag{" + tag(tags, v.key + "_factored") + "}";
+    if (factored == denominator || factored == "\\left(" + denominator + "\\right)") {
+      // one linear factor (s, 5s + 3): nothing to factor, and "s = s" reads as a slip
+      out.push_back(doc::paragraph(doc::text("Its denominator is already a single linear factor: ") + doc::math(denominator) +
+                                   doc::text(".")));
+      if (!factored_tag.empty()) out.push_back(doc::equation(denominator + factored_tag));
+    } else {
+      out.push_back(doc::paragraph(doc::text("Its denominator factored:")));
+      out.push_back(doc::equation(denominator + " = " + factored + factored_tag));
+    }
     std::vector<Rich> header{doc::text("pole"), doc::text("multiplicity"), doc::text("power r"),
                              doc::text("coefficient of ") + doc::math("1/(s-p)^r"), doc::text("term of the solution")};
     std::vector<std::vector<Rich>> rows;
@@ -412,7 +486,8 @@ doc::Document segment_blocks(const SegmentView& v, const CaseParameters& p, cons
                                  doc::math("A_r = \\frac{1}{(m-r)!}\\frac{d^{m-r}}{ds^{m-r}}\\left[(s-p)^m F(s)\\right]_{s=p}") +
                                  doc::text(" (a complex pair by its coefficient at the upper pole; the term is twice the real part):")));
     out.push_back(doc::table(header, rows, "lrrll"));
-    out.back().latex_columns = "p{2.6cm}rrp{4.4cm}p{5.6cm}";
+    // ragged right: a long coefficient breaks after a "+" and the "+" stays beside it
+    out.back().latex_columns = "p{2.6cm}rr>{\\raggedright\\arraybackslash}p{4.4cm}>{\\raggedright\\arraybackslash}p{5.6cm}";
     out.back().small = true;
     out.push_back(doc::paragraph(doc::text("The partial fractions:")));
     out.push_back(doc::equation(pp::display(v.laplace_lhs, partial_fraction_terms(steps, pp::latex_exact),
@@ -441,7 +516,7 @@ doc::Document segment_blocks(const SegmentView& v, const CaseParameters& p, cons
     const bool velocity_check = c.name.find("L^-1[s*") != std::string::npos;
     const bool mine = c.name.rfind(v.checks_prefix, 0) == 0 && velocity_check == (v.key[0] == 'd');
     if (!mine) continue;
-    passed.push_back(doc::text(c.passed ? "passed: " : "FAILED: ") + doc::code(c.name));
+    passed.push_back(doc::text(c.passed ? "passed: " : "FAILED: ") + check_rich(c.name));
   }
   (void)s;
   out.push_back(doc::paragraph(doc::text("Exact self-checks (each reduces to 0 in exact arithmetic):")));
@@ -614,7 +689,7 @@ doc::Document derivation_document(const CaseDerivation& d, const EquationTags& t
   {
     std::vector<Rich> items;
     for (const VerificationCheck& c : d.checks)
-      if (c.name.rfind("separation line:", 0) == 0) items.push_back(doc::text(c.passed ? "passed: " : "FAILED: ") + doc::code(c.name));
+      if (c.name.rfind("separation line:", 0) == 0) items.push_back(doc::text(c.passed ? "passed: " : "FAILED: ") + check_rich(c.name));
     out.push_back(doc::paragraph(doc::text("Exact checks on the line (the three slopes coincide, the transmitted torque vanishes):")));
     out.push_back(doc::list(items));
   }
@@ -663,9 +738,15 @@ doc::Document derivation_document(const CaseDerivation& d, const EquationTags& t
         "\\exp\\left(\\frac{a}{\\omega_c}\\arctan\\frac{\\dot\\theta_o - a e}{\\omega_c e}\\right)"));
     if (omega) {
       const ex w = canonical_sqrt(omega->square);
-      out.push_back(doc::equation("C = " + pp::latex(1 / w) + "\\sqrt{\\dot\\theta_o^{2} - " + pp::latex(F / J) + "\\,\\dot\\theta_o e + " +
-                                  pp::latex(p.K / J) + "\\,e^{2}}\\;\\exp\\left(" + pp::latex(a / w) +
-                                  "\\arctan\\frac{\\dot\\theta_o - " + pp::latex(a) + "\\,e}{" + pp::latex(w) + "\\,e}\\right)"));
+      // c·body with the case's numbers: "e^{2}" for 1·e², nothing for 0 (no "1\,e^{2}", no "- 0\,…")
+      const auto times = [](const ex& c, const std::string& body) {
+        return c.is_zero() ? std::string() : (c.is_equal(1) ? body : pp::latex(c) + "\\," + body);
+      };
+      const std::string damping = (F / J).is_zero() ? "" : " - " + times(F / J, "\\dot\\theta_o e");
+      const std::string shift = a.is_zero() ? "" : " - " + times(a, "e");
+      out.push_back(doc::equation("C = " + pp::latex(1 / w) + "\\sqrt{\\dot\\theta_o^{2}" + damping + " + " + times(p.K / J, "e^{2}") +
+                                  "}\\;\\exp\\left(" + pp::latex(a / w) + "\\arctan\\frac{\\dot\\theta_o" + shift + "}{" +
+                                  times(w, "e") + "}\\right)"));
     }
     out.push_back(doc::paragraph(doc::math("d\\ln C/dt = " + pp::latex(sc.dlnC_dt)) +
                                  doc::text(" exactly along every contact trajectory.  Crossing ") + doc::math("\\theta_o = \\theta_R") +
@@ -683,17 +764,48 @@ doc::Document derivation_document(const CaseDerivation& d, const EquationTags& t
   out.push_back(doc::heading(level, doc::text("Every exact check of this derivation")));
   {
     std::vector<Rich> items;
-    for (const VerificationCheck& c : d.checks) items.push_back(doc::text(c.passed ? "passed: " : "FAILED: ") + doc::code(c.name));
+    for (const VerificationCheck& c : d.checks) items.push_back(doc::text(c.passed ? "passed: " : "FAILED: ") + check_rich(c.name));
     out.push_back(doc::list(items));
   }
   return out;
 }
 
+namespace {
+
+// A branch condition ("output at motor; Fm^2 < 4*Jm*K; FL = 0") as a reader's text:
+// the words as words, the relations as mathematics (F_m^2 < 4J_mK).
+doc::Rich condition_rich(const std::string& condition) {
+  doc::Rich out;
+  for (std::size_t from = 0; from < condition.size();) {
+    const std::size_t end = std::min(condition.find("; ", from), condition.size());
+    const std::string clause = condition.substr(from, end - from);
+    if (!out.empty()) out = out + doc::text("; ");
+    if (clause.rfind("output at ", 0) == 0) {
+      out = out + doc::text(clause);
+    } else {
+      std::string math;
+      for (std::size_t k = 0; k < clause.size(); ++k) {
+        const char c = clause[k], next = k + 1 < clause.size() ? clause[k + 1] : '\0';
+        if ((c == 'F' || c == 'J') && (next == 'm' || next == 'L')) math += std::string(1, c) + "_" + next, ++k;
+        else if (c == '*') continue;
+        else if (c == '!' && next == '=') math += "\\neq", ++k;
+        else if (c == ',') math += ",\\ ";
+        else math += c;
+      }
+      out = out + doc::math(math);
+    }
+    from = end + 2;
+  }
+  return out;
+}
+
+}  // namespace
+
 doc::Document general_document(const std::vector<GeneralBranch>& branches, int level) {
   doc::Document out;
   for (const GeneralBranch& b : branches) {
     out.push_back(doc::heading(level, doc::text("Branch ") + doc::code(b.name)));
-    out.push_back(doc::paragraph(doc::text("Where it applies: ") + doc::code(b.condition) + doc::text(".")));
+    out.push_back(doc::paragraph(doc::text("Where it applies: ") + condition_rich(b.condition) + doc::text(".")));
     for (const BranchParameter& bp : b.branch_parameters)
       out.push_back(doc::paragraph(doc::math(pp::latex_symbol_name(bp.symbol.get_name()) + " = \\sqrt{" +
                                              pp::latex(bp.square_in_physical_parameters) + "}") +

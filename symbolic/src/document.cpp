@@ -1,7 +1,9 @@
 #include "backlash/symbolic/document.hpp"
 
 #include "backlash/symbolic/escape.hpp"
+#include "backlash/symbolic/pretty.hpp"
 
+#include <algorithm>
 #include <sstream>
 
 namespace backlash::symbolic::doc {
@@ -166,6 +168,42 @@ std::string to_markdown(const Document& document, const MarkdownOptions& options
   return out.str();
 }
 
+namespace {
+
+// A code line for LaTeX's verbatim, which takes ASCII only: the Greek letters of the
+// generated code's comments spelled out ("θm(t)" → "theta_m(t)", a dotted θ → "dtheta"),
+// other control or non-ASCII bytes as '?'.
+std::string verbatim_ascii(const std::string& line) {
+  static const std::pair<const char*, const char*> letters[] = {
+      {"\u03B8\u0307", "dtheta_"}, {"\u03B8", "theta_"}, {"\u03C9", "omega_"}, {"\u03C6", "phi"},
+      {"\u03B7", "eta"},           {"\u2212", "-"},      {"\u00B7", "*"}};
+  std::string out;
+  for (std::size_t k = 0; k < line.size();) {
+    bool replaced = false;
+    for (const auto& [from, to] : letters) {
+      const std::string f = from;
+      if (line.compare(k, f.size(), f) == 0) {
+        out += to;
+        k += f.size();
+        replaced = true;
+        break;
+      }
+    }
+    if (replaced) continue;
+    const unsigned char c = static_cast<unsigned char>(line[k]);
+    if (c >= 0x80) {  // the rest of an unknown UTF-8 sequence goes with it
+      out += '?';
+      for (++k; k < line.size() && (static_cast<unsigned char>(line[k]) & 0xC0) == 0x80;) ++k;
+      continue;
+    }
+    out += (c < 0x20 && c != '\t') ? '?' : static_cast<char>(c);
+    ++k;
+  }
+  return out;
+}
+
+}  // namespace
+
 std::string to_latex(const Document& document, const LatexOptions& options) {
   static const char* sections[] = {"chapter", "section", "subsection", "subsubsection", "paragraph", "subparagraph"};
   std::ostringstream out;
@@ -183,7 +221,20 @@ std::string to_latex(const Document& document, const LatexOptions& options) {
       case Block::Kind::Paragraph: out << latex_rich(b.content) << "\n\n"; break;
       case Block::Kind::Equation: {
         const bool tagged = b.equation.find("\\tag{") != std::string::npos;
-        out << "\\begin{equation*}\n" << b.equation << (tagged ? "" : "") << "\n\\end{equation*}\n\n";
+        // A line that no break between summands can bring within the text width (a single
+        // wide fraction of the general solutions) is scaled down to fit; an untagged
+        // equation only (a \tag cannot sit in a box), and never scaled up.
+        std::size_t widest = 0;
+        for (std::size_t from = 0; from <= b.equation.size();) {
+          const std::size_t end = std::min(b.equation.find("\\\\", from), b.equation.size());
+          widest = std::max(widest, pretty::visible_width(b.equation.substr(from, end - from)));
+          from = end + 2;
+        }
+        if (!tagged && widest > 100)
+          out << "\\begin{equation*}\n\\resizebox{\\ifdim\\width>\\linewidth\\linewidth\\else\\width\\fi}{!}{$\\displaystyle "
+              << b.equation << "$}\n\\end{equation*}\n\n";
+        else
+          out << "\\begin{equation*}\n" << b.equation << "\n\\end{equation*}\n\n";
         break;
       }
       case Block::Kind::Table: {
@@ -212,13 +263,15 @@ std::string to_latex(const Document& document, const LatexOptions& options) {
         std::string safe;
         std::istringstream lines(source);
         std::string line;
+        std::size_t longest = 0;
         while (std::getline(lines, line)) {
+          longest = std::max(longest, line.size());
           if (line.find("\\end{verbatim}") != std::string::npos) line = "  (line omitted)";
-          std::string printable;
-          for (char c : line) printable += (static_cast<unsigned char>(c) < 0x20 && c != '\t') || static_cast<unsigned char>(c) >= 0x80 ? '?' : c;
-          safe += printable + "\n";
+          safe += verbatim_ascii(line) + "\n";
         }
-        out << "{\\footnotesize\n\\begin{verbatim}\n" << safe << "\\end{verbatim}\n}\n\n";
+        // a verbatim line cannot wrap: past ~112 characters (the text width at 8 pt) the
+        // block is set at 7 pt, which holds ~133
+        out << (longest > 112 ? "{\\scriptsize" : "{\\footnotesize") << "\n\\begin{verbatim}\n" << safe << "\\end{verbatim}\n}\n\n";
         break;
       }
       case Block::Kind::List:

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -109,7 +110,12 @@ TEST_F(ReportRuns, LeavesThePagesTheFiguresAndThePdf) {
     svg.replace_extension(".svg");
     pdf.replace_extension(".pdf");
     ASSERT_TRUE(fs::exists(svg)) << svg;
-    EXPECT_NE(read(svg).find("<svg"), std::string::npos) << svg;
+    const std::string svg_text = read(svg);
+    EXPECT_NE(svg_text.find("<svg"), std::string::npos) << svg;
+    // gnuplot splits "θ_{m} and θ_{L}" into tspans; without xml:space="preserve" renderers
+    // drop the space that starts one ("θmand θL")
+    EXPECT_EQ(svg_text.find("<text>"), std::string::npos) << svg << ": a <text> that collapses its spaces";
+    EXPECT_NE(svg_text.find("<text xml:space=\"preserve\">"), std::string::npos) << svg;
     ASSERT_TRUE(fs::exists(pdf)) << pdf;
     EXPECT_EQ(read(pdf).rfind("%PDF", 0), 0u) << pdf;
   }
@@ -156,6 +162,29 @@ TEST_F(ReportRuns, EveryPdfPageRendersAndIsNotBlank) {
     ++rendered;
   }
   EXPECT_EQ(rendered, page_count);
+}
+
+TEST_F(ReportRuns, NothingInThePdfRunsIntoTheMargin) {
+  // pdflatex reports every line it could not fit ("Overfull \hbox (47.5pt too wide)"): an
+  // equation, a table or a word running past the text into the margin or off the page.
+  // report.tex is compiled again here (the report removes the log) and no line may
+  // stick out by more than 5 pt.
+  ASSERT_EQ(first_run().exit_code, 0) << first_run().err;
+  if (!pdflatex_installed()) GTEST_SKIP() << "pdflatex is not installed";
+  const fs::path source = base() / ReportRuns::first, build = base() / "latex";
+  fs::create_directories(build);
+  fs::copy_file(source / "report.tex", build / "report.tex");
+  fs::copy(source / "figures", build / "figures", fs::copy_options::recursive);
+  const CommandRun latex = run("cd " + build.string() + " && pdflatex -interaction=nonstopmode -halt-on-error -draftmode report.tex > /dev/null");
+  const std::string log = read(build / "report.log");
+  ASSERT_EQ(latex.exit_code, 0) << "report.tex did not compile: " << log.substr(log.size() > 2000 ? log.size() - 2000 : 0);
+  int over = 0;
+  for (std::size_t at = log.find("Overfull \\hbox ("); at != std::string::npos; at = log.find("Overfull \\hbox (", at + 1)) {
+    const double points = std::atof(log.c_str() + at + 16);
+    if (points > 5 && ++over <= 5)
+      ADD_FAILURE() << "returned a line " << points << " pt too wide: " << log.substr(at, log.find('\n', log.find('\n', at) + 1) - at);
+  }
+  EXPECT_EQ(over, 0) << over << " lines run into the margin";
 }
 
 TEST_F(ReportRuns, NoTemporaryFolderIsLeftAndAnOldReportIsReplacedWhole) {

@@ -106,6 +106,153 @@ TEST(CasePages, EachPageHasEveryPartOfTheChapter) {
   }
 }
 
+// A Markdown page's prose: code blocks, inline code and mathematics removed.
+std::string prose(const std::string& page) {
+  std::string out;
+  for (std::size_t at = 0; at < page.size();) {
+    if (page.compare(at, 3, "```") == 0) {
+      const auto end = page.find("```", at + 3);
+      at = end == std::string::npos ? page.size() : end + 3;
+    } else if (page.compare(at, 2, "$`") == 0) {
+      const auto end = page.find("`$", at + 2);
+      at = end == std::string::npos ? page.size() : end + 2;
+    } else if (page[at] == '`') {
+      const auto end = page.find('`', at + 1);
+      at = end == std::string::npos ? page.size() : end + 1;
+    } else {
+      out += page[at++];
+    }
+  }
+  return out;
+}
+
+TEST(CasePages, ProseNamesQuantitiesAsAReaderWould) {
+  // The ledger and the data files name quantities as identifiers ("Table20, dtheta_m0=.9",
+  // "theta_L dot", "Eq38"); outside code a page prints "Table 20", "θ̇m0", "θ̇L", "eq. 38".
+  const reports::BuiltReport& report = built();
+  // (a test's name, Table2_CaseI_…, is an identifier and stays one)
+  const std::regex raw(R"(\b(d?theta(\\?_[mLoR]0?)?|thetadot\w*|omega\\?_\w+)\b|\b(Table|Eq|Section)[0-9]+\b(?!\\?_)|cycle\(s\))");
+  for (const auto& [path, content] : report.files) {
+    if (path.size() < 3 || path.compare(path.size() - 3, 3, ".md") != 0) continue;
+    // the exact checks' formulas as mathematics, not as their ASCII names in code
+    EXPECT_EQ(content.find("passed: `"), std::string::npos) << path << ": a check printed as code";
+    const std::string text = prose(content);
+    std::smatch m;
+    EXPECT_FALSE(std::regex_search(text, m, raw))
+        << path << ": returned the raw \"" << m.str() << "\" in \"" << text.substr(m.position() > 60 ? m.position() - 60 : 0, 140)
+        << "\" instead of the reader's notation";
+  }
+}
+
+TEST(Index, EveryNumberOfTheCaseTableIsTheOneOnTheCasePage) {
+  // The index's row of a case (exact magnitude, thesis vs exact, describing function) and
+  // the case page print the same numbers.
+  const reports::BuiltReport& report = built();
+  const std::string& index = report.files.at("README.md");
+  for (const auto& [id, path] : report.case_pages) {
+    const std::string head = "| [" + id + "](" + path + ") |";
+    const auto at = index.find(head);
+    ASSERT_NE(at, std::string::npos) << "the index has no row for case " << id;
+    std::vector<std::string> cells;
+    std::stringstream row(index.substr(at + head.size(), index.find('\n', at) - at - head.size()));
+    std::string cell;
+    while (std::getline(row, cell, '|')) cells.push_back(cell.substr(1, cell.size() - 2));
+    ASSERT_GE(cells.size(), 8u) << "case " << id << ": returned " << cells.size() << " cells";
+    const std::string& page = report.files.at(path);
+    for (std::size_t k : {3u, 5u, 6u}) {  // exact magnitude, thesis vs exact, describing function
+      if (cells[k] == "—" || cells[k] == "n/a" || cells[k] == "none" || cells[k] == "agree: none") continue;
+      EXPECT_NE(page.find(cells[k]), std::string::npos) << "case " << id << ": the index says " << cells[k] << ", the page does not";
+    }
+  }
+}
+
+TEST(CasePages, CoefficientsOfOneAreNotPrinted) {
+  // "+ 1\,e^{2}" in eq. 38 with the case's numbers: a coefficient 1 is left out.
+  const reports::BuiltReport& report = built();
+  const std::regex one("(^|[^0-9.])1\\\\,[a-z\\\\]");
+  for (const auto& [id, path] : report.case_pages) {
+    const std::string& page = report.files.at(path);
+    for (std::size_t at = page.find("```math"); at != std::string::npos; at = page.find("```math", at + 1)) {
+      const std::string block = page.substr(at, page.find("```", at + 7) - at);
+      EXPECT_FALSE(std::regex_search(block, one)) << "case " << id << ": a coefficient 1 printed in " << block;
+    }
+  }
+}
+
+TEST(CasePages, TheCodeExcerptReadsTheSameInThePdf) {
+  // LaTeX's verbatim takes ASCII only: the excerpt's "θm(t)" must not become "??m(t)".
+  const reports::BuiltReport& report = built();
+  const std::string& tex = report.latex_document;
+  int blocks = 0;
+  for (std::size_t at = tex.find("\\begin{verbatim}"); at != std::string::npos; at = tex.find("\\begin{verbatim}", at + 1)) {
+    const std::string block = tex.substr(at, tex.find("\\end{verbatim}", at) - at);
+    EXPECT_EQ(block.find('?'), std::string::npos) << "returned an unprintable character in " << block.substr(0, 200);
+    EXPECT_NE(block.find("theta_m(t)"), std::string::npos) << "the excerpt's comment lost its θm(t): " << block.substr(0, 200);
+    ++blocks;
+  }
+  EXPECT_EQ(blocks, 8) << "returned " << blocks << " code excerpts instead of one per case";
+}
+
+TEST(ErrataLedger, ExactValuesAreMathematicsNotGinacText) {
+  // The ledger's closed forms ("-180*atan(5/54)*Pi^(-1)") are printed as formulas.
+  const reports::BuiltReport& report = built();
+  for (const char* page : {"errata.md", "README.md"}) {
+    const std::string& text = report.files.at(page);
+    for (const char* raw : {"Pi^(", "atan("})  // (the causes quote sqrt(…) and t* in words)
+      EXPECT_EQ(prose(text).find(raw), std::string::npos) << page << ": returned raw GiNaC text \"" << raw << "\"";
+    EXPECT_NE(text.find("\\arctan"), std::string::npos) << page << ": no exact angle as a formula";
+  }
+  EXPECT_EQ(report.latex_document.find("Pi\\textasciicircum"), std::string::npos) << "report.tex prints GiNaC's Pi^(-1)";
+}
+
+TEST(Figures, LabelsAndReferenceLevelsLieInsideTheAxes) {
+  // A case label at the end of a sweep or a divider level on the border is cut off or
+  // hidden by the frame: every label and every horizontal level lies inside the ranges
+  // set, with room for its text on the right.
+  const reports::BuiltReport& report = built();
+  for (const reports::Plot& plot : report.figures) {
+    if (!plot.labels.empty()) {
+      // gnuplot's autoscale ends an axis at the last point: a label there is cut
+      EXPECT_TRUE(plot.x_range.has_value()) << plot.name << ": labels without a horizontal range";
+      EXPECT_TRUE(plot.y_range.has_value()) << plot.name << ": labels without a vertical range";
+    }
+    for (const reports::Label& label : plot.labels) {
+      if (plot.x_range) {
+        const double width = plot.x_range->second - plot.x_range->first;
+        EXPECT_GE(label.x, plot.x_range->first) << plot.name << ": label '" << label.text << "'";
+        EXPECT_LE(label.x, plot.x_range->second - 0.04 * width)
+            << plot.name << ": label '" << label.text << "' at x = " << label.x << " leaves no room before " << plot.x_range->second;
+      }
+      if (plot.y_range) {
+        const double height = plot.y_range->second - plot.y_range->first;
+        EXPECT_GT(label.y, plot.y_range->first + 0.02 * height) << plot.name << ": label '" << label.text << "'";
+        EXPECT_LT(label.y, plot.y_range->second - 0.02 * height)
+            << plot.name << ": label '" << label.text << "' at y = " << label.y << " on the border " << plot.y_range->second;
+      }
+    }
+  }
+}
+
+TEST(Figures, DividerFiguresShowEveryLevelAndReading) {
+  // Figs. 3 and 8: the levels b/θ̇m0 and the recombination times read off them are the
+  // figure's point; none may fall outside the vertical range.
+  const reports::BuiltReport& report = built();
+  int checked = 0;
+  for (const reports::Plot& plot : report.figures) {
+    for (const reports::Series& s : plot.series) {
+      if (s.label.rfind("b/", 0) != 0 && s.label.rfind("recombination times read off", 0) != 0) continue;
+      ASSERT_TRUE(plot.y_range.has_value()) << plot.name << ": no vertical range";
+      for (double y : s.y) {
+        if (!std::isfinite(y)) continue;
+        EXPECT_GT(y, plot.y_range->first) << plot.name << ": " << s.label;
+        EXPECT_LT(y, plot.y_range->second) << plot.name << ": " << s.label << " at " << y << " outside [.., " << plot.y_range->second << "]";
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 6) << "returned " << checked << " divider points instead of those of figs. 3 and 8";
+}
+
 TEST(Figures, EveryFigureHasDataLabelledAxesAndALegend) {
   const reports::BuiltReport& report = built();
   ASSERT_FALSE(report.figures.empty());

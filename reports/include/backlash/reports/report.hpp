@@ -1,7 +1,7 @@
 // backlash/reports/report.hpp — the report `backlash report` writes: for each of
 // the thesis's eight cases a page that reads like the chapter it replaces
 // (Markdown for GitHub/GitLab and a LaTeX section), the general solutions, the
-// errata ledger, every figure of the thesis redrawn (SVG + PNG + its data),
+// errata ledger, every figure of the thesis redrawn (SVG for the web, PDF for report.pdf, its data as CSV),
 // the machine-readable outputs (JSON, CSV), and report.pdf when pdflatex is
 // installed.  Nothing in a page is typed by hand: the derivations come from
 // symbolic/, the numbers from numeric/, the thesis's printed values from the
