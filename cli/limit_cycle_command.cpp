@@ -27,12 +27,12 @@ void run_limit_cycle(const LimitCycleOptions& options) {
   if (c.spec.experiment && c.spec.experiment->kind == model::ExperimentKind::Step)
     lc.step = model::to_double(c.spec.experiment->step);
   const numeric::LimitCycle cycle = numeric::find_limit_cycle(c.model(), lc);
-  const bool found = cycle.status == "limit_cycle";
+  const bool found = cycle.status == numeric::CycleStatus::LimitCycle;
   const bool with_effects = c.model().effects().any();
   if (options.json) {
     auto value = [&](double v) { return found && std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
     nlohmann::json out{{"case", c.spec.id},
-                       {"status", cycle.status},
+                       {"status", numeric::to_string(cycle.status)},
                        {"amplitude", value(cycle.amplitude)},
                        {"peak_to_peak", value(cycle.peak_to_peak)},
                        {"period", value(cycle.period)},

@@ -150,8 +150,8 @@ std::string csv_row(const numeric::SweepRow& r) {
   std::replace(effects.begin(), effects.end(), ',', ';');  // one CSV cell
   effects.erase(std::remove(effects.begin(), effects.end(), ' '), effects.end());
   csv << symbolic::escape::csv_field(r.point.series) << "," << r.point.x << "," << p.Jm << "," << p.Fm << "," << p.JL << "," << p.FL << "," << p.K << ","
-      << p.backlash << "," << effects << "," << r.status << "," << r.branches;
-  if (r.status == "limit_cycle") {
+      << p.backlash << "," << effects << "," << numeric::to_string(r.status) << "," << r.branches;
+  if (r.status == numeric::SweepStatus::LimitCycle) {
     csv << "," << r.cycle.peak_to_peak << "," << r.cycle.amplitude << "," << r.cycle.period << ",";
     if (std::isfinite(r.cycle.separation_velocity)) csv << r.cycle.separation_velocity;  // none: a pure bounce cycle
     csv << "," << r.cycle.multiplier << "\n";
@@ -208,11 +208,11 @@ void run_sweep_command(const SweepOptions& o) {
         const std::string line = csv_row(r);
         if (std::fputs(line.c_str(), out) < 0) throw std::runtime_error("cannot write the sweep's output");
         ++rows;
-        if (r.status != "limit_cycle" && !r.reason.empty() && ++without_cycle <= reasons_shown) {
+        if (r.status != numeric::SweepStatus::LimitCycle && !r.reason.empty() && ++without_cycle <= reasons_shown) {
           std::string reason = r.reason;
           for (char& ch : reason)
             if (ch == '\n' || ch == '\r') ch = ' ';
-          std::fprintf(stderr, "sweep: %s x = %.12g: %s: %s\n", r.point.series.c_str(), r.point.x, r.status.c_str(),
+          std::fprintf(stderr, "sweep: %s x = %.12g: %s: %s\n", r.point.series.c_str(), r.point.x, numeric::to_string(r.status),
                        reason.c_str());
         }
       },

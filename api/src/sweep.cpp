@@ -102,7 +102,7 @@ std::string Sweep::csv() const {
     effects.erase(std::remove(effects.begin(), effects.end(), ' '), effects.end());
     csv << r.point.series << "," << r.point.x << "," << p.Jm << "," << p.Fm << "," << p.JL << "," << p.FL << "," << p.K << ","
         << p.backlash << "," << effects << "," << status_of(r) << "," << r.branches;
-    if (status_of(r) == "limit_cycle") {
+    if (r.status == numeric::SweepStatus::LimitCycle) {
       csv << "," << r.cycle.peak_to_peak << "," << r.cycle.amplitude << "," << r.cycle.period << ",";
       if (std::isfinite(r.cycle.separation_velocity)) csv << r.cycle.separation_velocity;  // none: a pure bounce cycle
       csv << "," << r.cycle.multiplier << "\n";

@@ -196,7 +196,7 @@ struct Cycle {
   numeric::LimitCycle cycle;
   /// "limit_cycle", "none" (reason in cycle.reason) or "divergent": the CLI's `status`.
   std::string status() const;
-  bool found() const { return status() == "limit_cycle"; }
+  bool found() const { return cycle.status == numeric::CycleStatus::LimitCycle; }
   std::string json() const;  ///< `limit-cycle CASE --json`
   std::string text() const;  ///< `limit-cycle CASE`
 };
