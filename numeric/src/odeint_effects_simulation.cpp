@@ -662,11 +662,15 @@ class Simulator {
   // (the start, after an impact); reports stick (and separation) events.  Returns a
   // status when a stop rule fires.
   std::optional<SimulationStatus> settle();
+  bool settle_body(Body body);
 
   // ---- segments
   template <class Vector, class System, class AtState, class ProbeFn, class JetFn>
   Outcome<Vector> scan(const System& system, const Vector& y0, double horizon, double dt_max, const ScanSetup& setup,
                        AtState at_state, ProbeFn probe, JetFn jet);
+  template <class Vector, class Stepper, class System>
+  std::pair<double, double> advance(Stepper& stepper, const System& system, const std::vector<double>& stops,
+                                    std::size_t& next_stop, double t_old);
   template <class Vector, class AtTau, class AtState, class ProbeFn>
   bool scan_step(double ta, double tb, double dt_max, const ScanSetup& setup, ScanState& seen, Outcome<Vector>& out,
                  AtTau at_tau, AtState at_state, ProbeFn probe);
@@ -742,17 +746,7 @@ Outcome<Vector> Simulator::scan(const System& system, const Vector& y0, double h
   stepper.initialize(y0, 0.0, dt0);
   double t_old = 0;
   while (t_old < horizon) {
-    if (next_stop < stops.size() && stepper.current_time() + stepper.current_time_step() > stops[next_stop]) {
-      const Vector here = stepper.current_state();
-      stepper.initialize(here, t_old, stops[next_stop] - t_old);
-    }
-    const auto step = stepper.do_step(system);
-    if (!finite(stepper.current_state()) || !std::isfinite(step.second)) throw NonFiniteState{};
-    // A step that no longer advances time, or an absurd number of them: odeint gives up.
-    if (!(step.second > step.first) || ++steps_ > kStepBudget) throw NonFiniteState{};
-    while (next_stop < stops.size() &&
-           stops[next_stop] <= step.second + 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, step.second))
-      ++next_stop;
+    const auto step = advance<Vector>(stepper, system, stops, next_stop, t_old);
     const double ta = t_old, tb = std::min(step.second, horizon);
     auto at_tau = [&](double tau) {
       Vector z;
@@ -784,6 +778,25 @@ Outcome<Vector> Simulator::scan(const System& system, const Vector& y0, double h
     t_old = tb;
   }
   return out;
+}
+
+// One accepted step of the dense-output stepper from t_old, shortened to land exactly on the next
+// stop (a delay breakpoint); a non-finite state, a step that no longer advances time or an
+// absurd number of steps is odeint giving up.
+template <class Vector, class Stepper, class System>
+std::pair<double, double> Simulator::advance(Stepper& stepper, const System& system, const std::vector<double>& stops,
+                                             std::size_t& next_stop, double t_old) {
+  if (next_stop < stops.size() && stepper.current_time() + stepper.current_time_step() > stops[next_stop]) {
+    const Vector here = stepper.current_state();
+    stepper.initialize(here, t_old, stops[next_stop] - t_old);
+  }
+  const auto step = stepper.do_step(system);
+  if (!finite(stepper.current_state()) || !std::isfinite(step.second)) throw NonFiniteState{};
+  if (!(step.second > step.first) || ++steps_ > kStepBudget) throw NonFiniteState{};
+  while (next_stop < stops.size() &&
+         stops[next_stop] <= step.second + 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, step.second))
+    ++next_stop;
+  return {step.first, step.second};
 }
 
 // The samples of one accepted step [ta, tb] (spaced so that oo_.interior_checks fit in a step of
@@ -833,6 +846,30 @@ bool Simulator::scan_step(double ta, double tb, double dt_max, const ScanSetup& 
   return false;
 }
 
+// One separate body at the start of a mode: a stuck body stays stuck (its Coulomb level > 0); a
+// body at rest sticks when its static torque is within its Coulomb level, else it slips toward
+// that torque.  True: it sticks now (the caller marks it, after both bodies are settled).
+bool Simulator::settle_body(Body body) {
+  const bool motor = body == Body::Motor;
+  bool& stuck = motor ? st_.motor_stuck : st_.load_stuck;
+  double& velocity = motor ? st_.dtheta_m : st_.dtheta_L;
+  int& slip = motor ? s_m_ : s_L_;
+  const double level = motor ? m_.Tm : m_.TL;
+  if (stuck && level > 0) {
+    velocity = 0;
+    slip = 0;
+    return false;
+  }
+  stuck = false;
+  slip = sgn(velocity);
+  if (velocity == 0 && level > 0) {
+    const double n = motor ? motor_static_torque() : load_static_torque();
+    if (std::fabs(n) <= level) return true;
+    slip = sgn(n);
+  }
+  return false;
+}
+
 std::optional<SimulationStatus> Simulator::settle() {
   if (st_.in_contact && !m_.compliant) {
     if (st_.motor_stuck || st_.load_stuck) {
@@ -864,32 +901,9 @@ std::optional<SimulationStatus> Simulator::settle() {
     }
     return std::nullopt;
   }
-  // Separate bodies (free flight or the mesh).
-  bool motor_sticks = false, load_sticks = false;
-  if (st_.motor_stuck && m_.Tm > 0) {
-    st_.dtheta_m = 0;
-    s_m_ = 0;
-  } else {
-    st_.motor_stuck = false;
-    s_m_ = sgn(st_.dtheta_m);
-    if (st_.dtheta_m == 0 && m_.Tm > 0) {
-      const double n = motor_static_torque();
-      if (std::fabs(n) <= m_.Tm) motor_sticks = true;
-      else s_m_ = sgn(n);
-    }
-  }
-  if (st_.load_stuck && m_.TL > 0) {
-    st_.dtheta_L = 0;
-    s_L_ = 0;
-  } else {
-    st_.load_stuck = false;
-    s_L_ = sgn(st_.dtheta_L);
-    if (st_.dtheta_L == 0 && m_.TL > 0) {
-      const double n = load_static_torque();
-      if (std::fabs(n) <= m_.TL) load_sticks = true;
-      else s_L_ = sgn(n);
-    }
-  }
+  // Separate bodies (free flight or the mesh): the motor first (the load's static torque
+  // through the mesh sees the motor's velocity as settled).
+  const bool motor_sticks = settle_body(Body::Motor), load_sticks = settle_body(Body::Load);
   if (motor_sticks) st_.motor_stuck = true;
   if (load_sticks) st_.load_stuck = true;
   if (motor_sticks || load_sticks) {

@@ -321,6 +321,8 @@ class OdeintRun {
   std::optional<SimulationStatus> contact();
   std::optional<SimulationStatus> flight();
   std::optional<SimulationStatus> impact(const HybridState& before, int face_hit, bool opposite);
+  SimulationStatus flight_to_end(const FreeFrame& frame, const FreeWitnesses& w, double rest_tau, const FreeVector& y_rest,
+                                 const FreeVector& y_end, double remaining);
   template <class AtTau>
   bool contact_sample(const ContactWitness& w, ContactScan& scan, double s_prev, double s, AtTau at_tau,
                       ContactVector& y_end);
@@ -485,23 +487,28 @@ std::optional<SimulationStatus> OdeintRun::flight() {
     return false;
   }, first_step);
   include(frame.at(scan.event_tau ? y_event : y_end));
-  if (!scan.event_tau) {
-    const HybridState end = frame.at(y_end);
-    if (w.speed(y_end) < 0) {
-      const double t_end = t_ + remaining;
-      t_ += scan.rest_tau;
-      state_ = frame.at(y_rest);
-      push_event(EventKind::Rest, false);
-      t_ = t_end;
-      state_ = end;
-      return SimulationStatus::Rest;
-    }
-    state_ = end;
-    t_ = o_.t_end;
-    return SimulationStatus::Completed;
-  }
+  if (!scan.event_tau) return flight_to_end(frame, w, scan.rest_tau, y_rest, y_end, remaining);
   t_ += *scan.event_tau;
   return impact(frame.at(y_event), scan.opposite ? -face : face, scan.opposite);
+}
+
+// A free flight without a gap event to t_end: at rest (the event at the last time a velocity fell
+// below rest_velocity) when every velocity is below it at the end, else still moving.
+SimulationStatus OdeintRun::flight_to_end(const FreeFrame& frame, const FreeWitnesses& w, double rest_tau,
+                                          const FreeVector& y_rest, const FreeVector& y_end, double remaining) {
+  const HybridState end = frame.at(y_end);
+  if (w.speed(y_end) < 0) {
+    const double t_end = t_ + remaining;
+    t_ += rest_tau;
+    state_ = frame.at(y_rest);
+    push_event(EventKind::Rest, false);
+    t_ = t_end;
+    state_ = end;
+    return SimulationStatus::Rest;
+  }
+  state_ = end;
+  t_ = o_.t_end;
+  return SimulationStatus::Completed;
 }
 
 // One witness sample of a free flight at s (after s_prev): the first face reached between them
