@@ -55,7 +55,6 @@ inline nlohmann::json effects_json(const numeric::Effects& e) {
 
 /// A status as text, whether the numeric layer keeps it as text or as an enum with a
 /// to_string() beside it (as numeric::SimulationStatus).
-inline std::string status_text(const std::string& status) { return status; }
 template <class Status>
   requires std::is_enum_v<Status>
 std::string status_text(Status status) {

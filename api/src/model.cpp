@@ -128,6 +128,7 @@ Simulation Model::simulate_csv(const SimulationRequest& request, const TextSink&
   const char* contact_mode = out.effects.compliant() ? "mesh" : "contact";
   csv(csv_header);
   std::string line;
+  options.event_sink = [](const numeric::SimulationEvent&) {};  // the CSV prints samples only: events not kept
   options.sample_sink = [&](const numeric::TrajectorySample& s) {
     line.clear();
     append_sample(line, s, contact_mode);

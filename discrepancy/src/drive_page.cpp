@@ -180,10 +180,11 @@ std::string drive_corrected_case_file(const model::CaseSpec& spec, const DriveDi
   return out.str();
 }
 
-std::vector<std::pair<std::string, std::string>> drive_report_files(const model::CaseSpec& model, const std::string& data_name,
-                                                                    const std::string& validation_name,
-                                                                    const DriveDiscrepancyResult& r) {
-  std::vector<std::pair<std::string, std::string>> files;
+namespace {
+
+// The figures: the torque residual against velocity, torque and position over the nominal
+// model's worst windows (and the validation record's), the first round's candidates.
+void drive_figures(const DriveDiscrepancyResult& r, std::vector<std::pair<std::string, std::string>>& files) {
   const bool found = !r.effects.empty();
   // Torque residual against velocity: every sample's dot, and the mean in 60 velocity bins.
   std::vector<double> before(r.t.size()), after(r.t.size());
@@ -235,10 +236,11 @@ std::vector<std::pair<std::string, std::string>> drive_report_files(const model:
     for (const Candidate& c : r.rounds.front()) bars.push_back({c.effect, c.rms});
   files.push_back({"candidates.svg", bar_chart("First round: torque RMS with each candidate effect fitted", bars, r.rms_before,
                                                "best nominal " + number(r.rms_before))});
-  files.push_back({"discrepancy.json", drive_to_json(model, r)});
-  files.push_back({"corrected.toml", drive_corrected_case_file(model, r)});
+}
 
-  std::ostringstream md;
+// The page's head: status, filter, noise.
+void drive_page_head(std::ostringstream& md, const model::CaseSpec& model, const std::string& data_name,
+                     const DriveDiscrepancyResult& r) {
   md << "# Discrepancy: " << model.name << " against " << data_name << " (measured drive)\n\n";
   md << "**Status: `" << to_string(r.status) << "`.** " << r.t.size() << " samples at " << number(r.sample_rate)
      << " Hz. The comparison is in the torque domain: the measured drive against the torque the model needs along the "
@@ -254,6 +256,11 @@ std::vector<std::pair<std::string, std::string>> drive_report_files(const model:
      << ". At rest: |velocity| < " << number(r.rest_speed) << ".\n\n";
   md << "Units are the record's own (SI); the figures label them for a linear drive such as EMPS: position in m, velocity "
         "in m/s, the drive and its residual (the workflow's \"torque\") in N; for a rotary record read rad, rad/s and N·m.\n\n";
+}
+
+// The best nominal model's fitted parameters, and the effects named with their uncertainties.
+void drive_page_fits(std::ostringstream& md, const DriveDiscrepancyResult& r) {
+  const bool found = !r.effects.empty();
   if (!r.nominal_fit.empty()) {
     md << "## The best nominal model\n\nThe parameters the model file marks free are fitted first (torque domain, whole record):\n\n"
        << "| parameter | given | fitted | ± (1σ) |\n|---|---|---|---|\n";
@@ -276,6 +283,11 @@ std::vector<std::pair<std::string, std::string>> drive_report_files(const model:
        << number(r.tau_int_after) << " samples: the filtered residuals are far from independent). The corrected model: "
        << "[corrected.toml](corrected.toml).\n\n";
   }
+}
+
+// The gap before and after, on the estimation and the validation record, with the figures.
+void drive_page_gap(std::ostringstream& md, const std::string& data_name, const std::string& validation_name,
+                    const DriveDiscrepancyResult& r) {
   md << "## The gap\n\n| record | torque RMS, best nominal | torque RMS, corrected | position RMS over " << r.estimation.windows
      << " windows, nominal | position RMS, corrected |\n|---|---|---|---|---|\n";
   auto row = [&](const DriveScores& s, const std::string& label) {
@@ -288,6 +300,10 @@ std::vector<std::pair<std::string, std::string>> drive_report_files(const model:
   md << "![torque residual against velocity](torque_residual_vs_velocity.svg)\n\n![torque over time](torque_over_time.svg)\n\n"
      << "![position over windows](position_window.svg)\n\n";
   if (r.validation) md << "![validation record](validation_position_window.svg)\n\n";
+}
+
+// Where model and measurement disagree: by kind of motion, and the worst stretches.
+void drive_page_regions(std::ostringstream& md, const DriveDiscrepancyResult& r) {
   md << "## Where they disagree\n\nThe torque residual by kind of motion (a mean of opposite signs forward and backward is the "
         "signature of Coulomb friction; one sign everywhere, that of an offset):\n\n"
      << "| samples of | count | RMS before | mean before | RMS after | mean after |\n|---|---|---|---|---|---|\n";
@@ -302,6 +318,10 @@ std::vector<std::pair<std::string, std::string>> drive_report_files(const model:
   for (const TorqueRegion& g : worst)
     md << "| " << number(g.t_start) << " | " << number(g.t_end) << " | " << g.kind << " | " << g.samples << " | "
        << number(g.rms_before) << " | " << number(g.rms_after) << " |\n";
+}
+
+// Every round's candidates.
+void drive_page_candidates(std::ostringstream& md, const DriveDiscrepancyResult& r) {
   md << "\n## Candidates\n\nEach effect added to the current model and fitted on seven of ten blocks of the record; ΔBIC with "
         "n_eff = n/τ_int independent residuals; decisive: ΔBIC < −10, the held-out RMS at most 0.8 of the current one, no "
         "parameter at an end of its range.\n\n";
@@ -317,6 +337,23 @@ std::vector<std::pair<std::string, std::string>> drive_report_files(const model:
     md << "\n";
   }
   md << "![candidates](candidates.svg)\n";
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> drive_report_files(const model::CaseSpec& model, const std::string& data_name,
+                                                                    const std::string& validation_name,
+                                                                    const DriveDiscrepancyResult& r) {
+  std::vector<std::pair<std::string, std::string>> files;
+  drive_figures(r, files);
+  files.push_back({"discrepancy.json", drive_to_json(model, r)});
+  files.push_back({"corrected.toml", drive_corrected_case_file(model, r)});
+  std::ostringstream md;
+  drive_page_head(md, model, data_name, r);
+  drive_page_fits(md, r);
+  drive_page_gap(md, data_name, validation_name, r);
+  drive_page_regions(md, r);
+  drive_page_candidates(md, r);
   files.push_back({"discrepancy.md", md.str()});
   return files;
 }

@@ -710,12 +710,10 @@ double noise_level(double fs, const Band& band, double drive_noise, double posit
   return std::sqrt(drive_noise * drive_noise * hh + position_noise * position_noise * (m[kJ] * m[kJ] * aa + m[kF] * m[kF] * vv));
 }
 
-}  // namespace
-
-DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const measurements::MeasuredRecord& data,
-                                              const DriveOptions& options, const measurements::MeasuredRecord* validation) {
-  const auto started = std::chrono::steady_clock::now();
-  const std::string where = spec.source.filename().string();
+// The model and records a measured-drive workflow needs: a drive experiment, no backlash, the
+// logged drive in every record.
+void check_drive_inputs(const model::CaseSpec& spec, const std::string& where, const measurements::MeasuredRecord& data,
+                        const measurements::MeasuredRecord* validation) {
   if (!spec.experiment || spec.experiment->kind != model::ExperimentKind::Drive)
     throw std::invalid_argument(where + ": the model's [experiment] is not a measured drive (kind = \"drive\")");
   if (spec.backlash != 0)
@@ -723,17 +721,13 @@ DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const
   if (!data.drive) throw std::invalid_argument(data.source.string() + ": no drive column: a measured-drive model needs the logged drive");
   if (validation && !validation->drive)
     throw std::invalid_argument(validation->source.string() + ": no drive column: a measured-drive model needs the logged drive");
-  const double gain = model::to_double(spec.experiment->drive_gain);
-  const double t_end = spec.experiment->t_end ? model::to_double(*spec.experiment->t_end) : INFINITY;
+}
 
-  DriveDiscrepancyResult result;
-  result.given = numeric::parameters_of(spec);
-  const numeric::Effects file_effects = numeric::effects_of(spec);
-  (void)numeric::rigid_drive_of(result.given, file_effects, gain);  // refuses effects that need a gap
-
-  // The free nominal parameters: on a rigid drive only J and F show.
+// The free nominal parameters: on a rigid drive only J and F show (the names as given, with
+// the parameter each one moves).
+FreeSet nominal_free_of(const model::CaseSpec& spec, const std::string& where,
+                        std::vector<std::pair<std::string, int>>& free_names) {
   FreeSet nominal_free;
-  std::vector<std::pair<std::string, int>> free_names;
   for (const std::string& name : spec.fit_free) {
     int which = -1;
     if (name == "motor.J" || name == "load.J") which = kJ;
@@ -748,19 +742,14 @@ DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const
     nominal_free.on[which] = true;
     free_names.push_back({name, which});
   }
+  return nominal_free;
+}
 
-  // The band: uniform sampling, the cut-off, the filter.
-  std::size_t n = data.size();
-  while (n > 0 && data.t[n - 1] > t_end) --n;
-  if (n < 200) throw std::invalid_argument(data.source.string() + ": fewer than 200 samples before t_end: too short for inverse dynamics");
-  const std::vector<double> t(data.t.begin(), data.t.begin() + static_cast<std::ptrdiff_t>(n));
-  const std::vector<double> q(data.theta_out.begin(), data.theta_out.begin() + static_cast<std::ptrdiff_t>(n));
-  double fs = 0;
-  try {
-    fs = measurements::uniform_sample_rate(t);
-  } catch (const std::invalid_argument& error) {
-    throw std::invalid_argument(data.source.string() + ": t: " + error.what());
-  }
+// The band: the cut-off (given, or from the position's spectrum), the filter, its edge, the
+// noise levels and the speed below which a sample is at rest (three σ of the velocity noise the
+// filter lets through).
+Band band_of(const std::vector<double>& q, const std::vector<double>& u, double fs, const DriveOptions& options,
+             DriveDiscrepancyResult& result) {
   Band band;
   if (std::isfinite(options.cutoff)) {
     band.cutoff = options.cutoff;
@@ -777,66 +766,115 @@ DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const
   result.cutoff_from_spectrum = band.from_spectrum;
   result.spectrum_floor = band.floor;
   result.position_noise = estimate_noise(q);
-  {
-    std::vector<double> u(n);
-    for (std::size_t i = 0; i < n; ++i) u[i] = gain * (*data.drive)[i];
-    result.drive_noise = estimate_noise(u);
-  }
-  {  // at rest: slower than three σ of the velocity noise the filter lets through
-    std::vector<double> impulse(4096, 0.0);
-    impulse[2048] = 1;
-    const measurements::Derivatives d = measurements::derivatives(measurements::zero_phase_filter(impulse, band.filter), fs);
-    double vv = 0;
-    for (double x : d.velocity) vv += x * x;
-    band.rest_speed = 3 * result.position_noise * std::sqrt(vv);
-  }
+  result.drive_noise = estimate_noise(u);
+  std::vector<double> impulse(4096, 0.0);
+  impulse[2048] = 1;
+  const measurements::Derivatives d = measurements::derivatives(measurements::zero_phase_filter(impulse, band.filter), fs);
+  double vv = 0;
+  for (double x : d.velocity) vv += x * x;
+  band.rest_speed = 3 * result.position_noise * std::sqrt(vv);
   result.rest_speed = band.rest_speed;
+  return band;
+}
 
-  const Prepared p = prepare(data.source.filename().string(), data, gain, t_end, band, fs, options.holdout_fraction);
-  Work w{p, band, ranges_of(p)};
-
-  // The model as given, then the best nominal model.
-  Theta given;
-  given[kJ] = result.given.Jm + result.given.JL;
-  given[kF] = result.given.Fm + result.given.FL;
-  given[kTc] = file_effects.coulomb_motor + file_effects.coulomb_load;
-  given[kT0] = file_effects.torque_offset;
-  given[kL] = file_effects.saturation;
-  given[kTau] = file_effects.delay;
-  result.rms_given = rms_compared(p, residuals_of(p, band, given));
-  Theta nominal = given;
-  std::vector<double> nominal_sigma(kCount, NAN);
-  if (nominal_free.count() > 0) {
-    const Linear l = fit(w, given, nominal_free, p.all);
-    if (!l.ok)
-      throw std::invalid_argument(where + ": fit.free: the free nominal parameters do not fit the record to a physical drive (J > 0, F >= 0)");
-    const Polished polished = polish(w, l.m, nominal_free);
-    nominal = polished.m;
-    for (const auto& [name, which] : free_names) {
-      const double held = which == kJ ? (name == "motor.J" ? result.given.JL : result.given.Jm)
-                                      : (name == "motor.F" ? result.given.FL : result.given.Fm);
-      result.nominal_fit.push_back({name, nominal[which] - held, polished.sigma[which]});
-    }
+// The nominal parameters as the file names them, from J = Jm + JL and F = Fm + FL: the free
+// one takes the difference, the other is held.
+numeric::Parameters as_parameters(const numeric::Parameters& given, const std::vector<std::pair<std::string, int>>& free_names,
+                                  const Theta& m) {
+  numeric::Parameters out = given;
+  for (const auto& [name, which] : free_names) {
+    if (name == "motor.J") out.Jm = m[kJ] - out.JL;
+    if (name == "load.J") out.JL = m[kJ] - out.Jm;
+    if (name == "motor.F") out.Fm = m[kF] - out.FL;
+    if (name == "load.F") out.FL = m[kF] - out.Fm;
   }
-  auto as_parameters = [&](const Theta& m) {
-    numeric::Parameters out = result.given;
-    for (const auto& [name, which] : free_names) {
-      if (name == "motor.J") out.Jm = m[kJ] - out.JL;
-      if (name == "load.J") out.JL = m[kJ] - out.Jm;
-      if (name == "motor.F") out.Fm = m[kF] - out.FL;
-      if (name == "load.F") out.FL = m[kF] - out.Fm;
-    }
-    return out;
-  };
-  result.nominal = as_parameters(nominal);
-  const std::vector<double> r_nominal = residuals_of(p, band, nominal);
-  result.rms_before = rms_compared(p, r_nominal);
-  result.tau_int_before = tau_int_compared(p, r_nominal);
-  result.noise = noise_level(fs, band, result.drive_noise, result.position_noise, nominal);
+  return out;
+}
 
-  // Rounds: every remaining candidate added to the current model, fitted on the fitted blocks.
-  Theta current = nominal;
-  FreeSet current_free = nominal_free;
+// The fitted free nominal parameters as the file names them, with their uncertainties.
+std::vector<Parameter> named_nominal(const numeric::Parameters& given, const std::vector<std::pair<std::string, int>>& free_names,
+                                     const Theta& m, const double* sigma) {
+  std::vector<Parameter> out;
+  for (const auto& [name, which] : free_names) {
+    const double held = which == kJ ? (name == "motor.J" ? given.JL : given.Jm) : (name == "motor.F" ? given.FL : given.Fm);
+    out.push_back({name, m[which] - held, sigma[which]});
+  }
+  return out;
+}
+
+// The search runs whatever the nominal model's residual: the noise level is an estimate that
+// can be far too high in a closed loop (the Δ⁴ rule counts the controller's reaction to the
+// encoder's quantisation, a real and logged force, as drive noise), so it does not stop the
+// search; the decisive rule does, and the noise level only labels a quiet record's status.
+constexpr double kNoiseFactor = 1.15;
+
+// One trial of a round: the effects added to the current model, fitted on the fitted blocks.
+struct Trial {
+  Candidate c;
+  std::vector<std::string> effects;
+  Theta m;
+  FreeSet free;
+};
+
+// One round of the search: the current model fitted on the fitted blocks (`base`), and trials
+// judged against it by the decisive rule with one BIC penalty per added parameter.
+struct Round {
+  Work& w;
+  const DriveOptions& options;
+  const Linear& base;
+  const FreeSet& current_free;
+  double noise, base_holdout, n_eff;
+
+  Trial trial(const std::vector<std::string>& effects) const {
+    const Prepared& p = w.p;
+    const auto t0 = std::chrono::steady_clock::now();
+    const int before = w.least_squares;
+    Trial trial;
+    trial.effects = effects;
+    trial.free = current_free;
+    Theta start = base.m;
+    for (const std::string& effect : effects) {
+      trial.c.effect += (trial.c.effect.empty() ? "" : "+") + effect;
+      const int which = index_of_effect(effect);
+      trial.free.on[which] = true;
+      if (which == kL) start[kL] = w.ranges.L_max;
+    }
+    const Linear l = fit(w, start, trial.free, p.fit);
+    if (l.ok) {
+      trial.m = l.m;
+      judge(l, effects, trial);
+    } else {
+      trial.c.failure = "the least-squares fit gave no physical drive (J <= 0 or F < 0)";
+      trial.c.rms = trial.c.rms_fit = trial.c.rms_holdout = trial.c.bic = INFINITY;
+      trial.c.delta_bic = INFINITY;
+    }
+    trial.c.simulations = w.least_squares - before;
+    trial.c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return trial;
+  }
+
+  void judge(const Linear& l, const std::vector<std::string>& effects, Trial& trial) const {
+    const Prepared& p = w.p;
+    const std::vector<double> r = residuals_of(p, w.band, l.m);
+    for (const std::string& effect : effects) {
+      const int which = index_of_effect(effect);
+      trial.c.parameters.push_back({kEffectParameter[which], l.m[which], NAN});
+    }
+    const double added = static_cast<double>(effects.size());
+    trial.c.rms = rms_compared(p, r);
+    trial.c.rms_fit = std::sqrt(l.sse / p.fit.size());
+    trial.c.rms_holdout = std::sqrt(sse_on(r, p.holdout) / p.holdout.size());
+    trial.c.delta_bic = n_eff * std::log(std::max(l.sse, 1e-300) / std::max(base.sse, 1e-300)) + added * std::log(n_eff);
+    trial.c.bic = n_eff * std::log(std::max(l.sse, 1e-300) / p.fit.size()) + (trial.free.count() + 0.0) * std::log(n_eff);
+    trial.c.at_range_edge = at_edge(w, l.m, trial.free, l.clamped);
+    const bool confirmed = trial.c.rms_holdout <= options.decisive_holdout * base_holdout ||
+                           (base_holdout <= kNoiseFactor * noise && trial.c.rms_holdout <= 1.02 * base_holdout);
+    trial.c.decisive = trial.c.delta_bic < -options.decisive_bic && confirmed && !trial.c.at_range_edge;
+  }
+};
+
+// The candidates not already in the model.
+std::vector<std::string> remaining_candidates(const DriveOptions& options, const Theta& given) {
   std::vector<std::string> remaining;
   for (const std::string& e : options.candidates) {
     const int which = index_of_effect(e);
@@ -845,134 +883,62 @@ DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const
                          (which == kL && std::isfinite(given[kL])) || (which == kTau && given[kTau] > 0);
     if (!present) remaining.push_back(e);
   }
-  // The search runs whatever the nominal model's residual: the noise level is an estimate that
-  // can be far too high in a closed loop (the Δ⁴ rule counts the controller's reaction to the
-  // encoder's quantisation, a real and logged force, as drive noise), so it does not stop the
-  // search; the decisive rule does, and the noise level only labels a quiet record's status.
-  constexpr double noise_factor = 1.15;
-  while (static_cast<int>(result.effects.size()) < options.max_effects && !remaining.empty()) {
-    const Linear base = fit(w, current, current_free, p.fit);
-    if (!base.ok) break;
-    const std::vector<double> r_base = residuals_of(p, band, base.m);
-    const double base_holdout = std::sqrt(sse_on(r_base, p.holdout) / p.holdout.size());
-    const double tau_int = std::max(1.0, tau_int_compared(p, r_base));
-    const double n_eff = static_cast<double>(p.fit.size()) / tau_int;
-    struct Trial {
-      Candidate c;
-      std::vector<std::string> effects;
-      Theta m;
-      FreeSet free;
-    };
-    // One trial: the effects added to the current model, fitted on the fitted blocks, judged by
-    // the decisive rule with one BIC penalty per added parameter.
-    auto try_effects = [&](const std::vector<std::string>& effects) {
-      const auto t0 = std::chrono::steady_clock::now();
-      const int before = w.least_squares;
-      Trial trial;
-      trial.effects = effects;
-      trial.free = current_free;
-      Theta start = base.m;
-      for (const std::string& effect : effects) {
-        trial.c.effect += (trial.c.effect.empty() ? "" : "+") + effect;
-        const int which = index_of_effect(effect);
-        trial.free.on[which] = true;
-        if (which == kL) start[kL] = w.ranges.L_max;
-      }
-      const Linear l = fit(w, start, trial.free, p.fit);
-      if (l.ok) {
-        trial.m = l.m;
-        const std::vector<double> r = residuals_of(p, band, l.m);
-        for (const std::string& effect : effects) {
-          const int which = index_of_effect(effect);
-          trial.c.parameters.push_back({kEffectParameter[which], l.m[which], NAN});
-        }
-        const double added = static_cast<double>(effects.size());
-        trial.c.rms = rms_compared(p, r);
-        trial.c.rms_fit = std::sqrt(l.sse / p.fit.size());
-        trial.c.rms_holdout = std::sqrt(sse_on(r, p.holdout) / p.holdout.size());
-        trial.c.delta_bic = n_eff * std::log(std::max(l.sse, 1e-300) / std::max(base.sse, 1e-300)) + added * std::log(n_eff);
-        trial.c.bic = n_eff * std::log(std::max(l.sse, 1e-300) / p.fit.size()) + (trial.free.count() + 0.0) * std::log(n_eff);
-        trial.c.at_range_edge = at_edge(w, l.m, trial.free, l.clamped);
-        const bool confirmed = trial.c.rms_holdout <= options.decisive_holdout * base_holdout ||
-                               (base_holdout <= noise_factor * result.noise && trial.c.rms_holdout <= 1.02 * base_holdout);
-        trial.c.decisive = trial.c.delta_bic < -options.decisive_bic && confirmed && !trial.c.at_range_edge;
-      } else {
-        trial.c.failure = "the least-squares fit gave no physical drive (J <= 0 or F < 0)";
-        trial.c.rms = trial.c.rms_fit = trial.c.rms_holdout = trial.c.bic = INFINITY;
-        trial.c.delta_bic = INFINITY;
-      }
-      trial.c.simulations = w.least_squares - before;
-      trial.c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      return trial;
-    };
-    auto by_delta_bic = [](const Trial& a, const Trial& b) { return a.c.delta_bic < b.c.delta_bic; };
-    std::vector<Trial> trials;
-    for (const std::string& effect : remaining) trials.push_back(try_effects({effect}));
-    std::stable_sort(trials.begin(), trials.end(), by_delta_bic);
-    auto winner = std::find_if(trials.begin(), trials.end(), [](const Trial& trial) { return trial.c.decisive; });
-    // No single effect decisive: pairs, by the same rule (two parameters' penalty).  Two effects
-    // can each be too weak alone — the nominal parameters absorb part of each (a viscous
-    // friction raised by a missing Coulomb friction) — and decisive together.
-    if (winner == trials.end() && remaining.size() >= 2 && static_cast<int>(result.effects.size()) + 2 <= options.max_effects) {
-      std::vector<Trial> pairs;
-      for (std::size_t i = 0; i < trials.size(); ++i)  // in the order of the single trials
-        for (std::size_t j = i + 1; j < trials.size(); ++j) pairs.push_back(try_effects({trials[i].effects[0], trials[j].effects[0]}));
-      std::stable_sort(pairs.begin(), pairs.end(), by_delta_bic);
-      const std::size_t singles = trials.size();
-      trials.insert(trials.end(), pairs.begin(), pairs.end());
-      winner = std::find_if(trials.begin() + static_cast<std::ptrdiff_t>(singles), trials.end(),
-                            [](const Trial& trial) { return trial.c.decisive; });
-    }
-    std::vector<Candidate> round;
-    for (const Trial& trial : trials) round.push_back(trial.c);
-    result.rounds.push_back(round);
-    if (winner == trials.end()) break;
-    // The winner with everything free so far, refitted on the whole record.
-    const Linear whole = fit(w, winner->m, winner->free, p.all);
-    current = whole.ok ? whole.m : winner->m;
-    current_free = winner->free;
-    for (std::size_t e = 0; e < winner->effects.size(); ++e) {
-      Candidate named = winner->c;
-      named.effect = winner->effects[e];
-      named.parameters = {winner->c.parameters[e]};
-      result.effects.push_back(named);
-      remaining.erase(std::remove(remaining.begin(), remaining.end(), winner->effects[e]), remaining.end());
-    }
-  }
+  return remaining;
+}
 
-  // The corrected model: everything free polished together; uncertainties.
-  if (!result.effects.empty()) {
-    const Polished polished = polish(w, current, current_free);
-    current = polished.m;
-    for (Candidate& c : result.effects) {
-      const int which = index_of_effect(c.effect);
-      c.parameters = {{kEffectParameter[which], current[which], polished.sigma[which]}};
-    }
-    for (const auto& [name, which] : free_names) {
-      const double held = which == kJ ? (name == "motor.J" ? result.given.JL : result.given.Jm)
-                                      : (name == "motor.F" ? result.given.FL : result.given.Fm);
-      result.corrected_nominal.push_back({name, current[which] - held, polished.sigma[which]});
-    }
+// One round: every remaining effect tried alone and, when none is decisive, in pairs (two
+// effects can each be too weak alone — the nominal parameters absorb part of each, a viscous
+// friction raised by a missing Coulomb friction — and decisive together).  The round's
+// candidates go to the result; the winner, if any, is named.  False: no winner, the search ends.
+bool search_round(Work& w, const DriveOptions& options, double noise, Theta& current, FreeSet& current_free,
+                  std::vector<std::string>& remaining, DriveDiscrepancyResult& result) {
+  const Prepared& p = w.p;
+  const Linear base = fit(w, current, current_free, p.fit);
+  if (!base.ok) return false;
+  const std::vector<double> r_base = residuals_of(p, w.band, base.m);
+  const double base_holdout = std::sqrt(sse_on(r_base, p.holdout) / p.holdout.size());
+  const double tau_int = std::max(1.0, tau_int_compared(p, r_base));
+  const Round round{w, options, base, current_free, noise, base_holdout, static_cast<double>(p.fit.size()) / tau_int};
+  auto by_delta_bic = [](const Trial& a, const Trial& b) { return a.c.delta_bic < b.c.delta_bic; };
+  std::vector<Trial> trials;
+  for (const std::string& effect : remaining) trials.push_back(round.trial({effect}));
+  std::stable_sort(trials.begin(), trials.end(), by_delta_bic);
+  auto winner = std::find_if(trials.begin(), trials.end(), [](const Trial& trial) { return trial.c.decisive; });
+  if (winner == trials.end() && remaining.size() >= 2 && static_cast<int>(result.effects.size()) + 2 <= options.max_effects) {
+    std::vector<Trial> pairs;
+    for (std::size_t i = 0; i < trials.size(); ++i)  // in the order of the single trials
+      for (std::size_t j = i + 1; j < trials.size(); ++j) pairs.push_back(round.trial({trials[i].effects[0], trials[j].effects[0]}));
+    std::stable_sort(pairs.begin(), pairs.end(), by_delta_bic);
+    const std::size_t singles = trials.size();
+    trials.insert(trials.end(), pairs.begin(), pairs.end());
+    winner = std::find_if(trials.begin() + static_cast<std::ptrdiff_t>(singles), trials.end(),
+                          [](const Trial& trial) { return trial.c.decisive; });
   }
-  result.parameters = as_parameters(current);
-  result.corrected_effects = file_effects;
-  result.corrected_effects.coulomb_motor = current[kTc] - file_effects.coulomb_load;
-  result.corrected_effects.torque_offset = current[kT0];
-  result.corrected_effects.saturation = current[kL];
-  result.corrected_effects.delay = current[kTau];
-  const std::vector<double> r_after = residuals_of(p, band, current);
-  result.rms_after = rms_compared(p, r_after);
-  result.tau_int_after = tau_int_compared(p, r_after);
-  result.classes = classes_of(p, r_nominal, r_after);
-  result.stretches = stretches_of(p, r_nominal, r_after);
-  if (!result.effects.empty()) result.status = Status::EffectFound;
-  else if (result.rms_before <= noise_factor * result.noise) result.status = Status::NoDiscrepancy;
-  else result.status = Status::Unexplained;
+  std::vector<Candidate> candidates;
+  for (const Trial& trial : trials) candidates.push_back(trial.c);
+  result.rounds.push_back(candidates);
+  if (winner == trials.end()) return false;
+  // The winner with everything free so far, refitted on the whole record.
+  const Linear whole = fit(w, winner->m, winner->free, p.all);
+  current = whole.ok ? whole.m : winner->m;
+  current_free = winner->free;
+  for (std::size_t e = 0; e < winner->effects.size(); ++e) {
+    Candidate named = winner->c;
+    named.effect = winner->effects[e];
+    named.parameters = {winner->c.parameters[e]};
+    result.effects.push_back(named);
+    remaining.erase(std::remove(remaining.begin(), remaining.end(), winner->effects[e]), remaining.end());
+  }
+  return true;
+}
 
-  // Figures' traces and the position over windows.
+// The figures' traces: velocity, the torque measured (the held drive, no delay, no limit,
+// through the filter) and what each model needs, and the position predicted over windows.
+void estimation_traces(const Prepared& p, const Band& band, const std::vector<double>& r_nominal,
+                       const std::vector<double>& r_after, const Theta& nominal, const Theta& current, double gain,
+                       const DriveOptions& options, DriveDiscrepancyResult& result) {
   result.t = p.t;
   result.velocity = p.v;
-  // The measured torque as compared: the held drive (no delay, no limit) through the filter.
   const std::vector<double> drive_f = measurements::zero_phase_filter(held_drive(p, INFINITY, 0), band.filter);
   result.torque_measured.resize(p.size());
   result.torque_nominal.resize(p.size());
@@ -989,30 +955,138 @@ DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const
   result.position_corrected = wc.x;
   result.window_starts = wn.starts;
   result.estimation = {p.name, static_cast<int>(p.size()), result.rms_before, result.rms_after, wn.rms, wc.rms, wn.windows};
+}
 
-  if (validation) {
-    double fs_validation = 0;
-    try {
-      fs_validation = measurements::uniform_sample_rate(validation->t);
-    } catch (const std::invalid_argument& error) {
-      throw std::invalid_argument(validation->source.string() + ": t: " + error.what());
-    }
-    if (std::fabs(fs_validation - fs) > 1e-6 * fs)
-      throw std::invalid_argument(validation->source.string() + ": sampled at " + std::to_string(fs_validation) +
-                                  " Hz, the estimation record at " + std::to_string(fs) + " Hz: the filter would differ");
-    const Prepared pv = prepare(validation->source.filename().string(), *validation, gain, INFINITY, band, fs, 0);
-    if (pv.size() < 200) throw std::invalid_argument(validation->source.string() + ": fewer than 200 samples");
-    const double rn = rms_compared(pv, residuals_of(pv, band, nominal));
-    const double rc = rms_compared(pv, residuals_of(pv, band, current));
-    const WindowPrediction vn = predict_windows(pv, nominal, gain, options.window, band.rest_speed);
-    const WindowPrediction vc = predict_windows(pv, current, gain, options.window, band.rest_speed);
-    result.validation = DriveScores{pv.name, static_cast<int>(pv.size()), rn, rc, vn.rms, vc.rms, vn.windows};
-    result.validation_t = pv.t;
-    result.validation_position = pv.q;
-    result.validation_nominal = vn.x;
-    result.validation_corrected = vc.x;
-    result.validation_window_starts = vn.starts;
+// The validation record (not fitted): sampled as the estimation record, scored with both models.
+void score_validation(const measurements::MeasuredRecord& validation, const Band& band, double fs, double gain,
+                      const Theta& nominal, const Theta& current, const DriveOptions& options,
+                      DriveDiscrepancyResult& result) {
+  double fs_validation = 0;
+  try {
+    fs_validation = measurements::uniform_sample_rate(validation.t);
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument(validation.source.string() + ": t: " + error.what());
   }
+  if (std::fabs(fs_validation - fs) > 1e-6 * fs)
+    throw std::invalid_argument(validation.source.string() + ": sampled at " + std::to_string(fs_validation) +
+                                " Hz, the estimation record at " + std::to_string(fs) + " Hz: the filter would differ");
+  const Prepared pv = prepare(validation.source.filename().string(), validation, gain, INFINITY, band, fs, 0);
+  if (pv.size() < 200) throw std::invalid_argument(validation.source.string() + ": fewer than 200 samples");
+  const double rn = rms_compared(pv, residuals_of(pv, band, nominal));
+  const double rc = rms_compared(pv, residuals_of(pv, band, current));
+  const WindowPrediction vn = predict_windows(pv, nominal, gain, options.window, band.rest_speed);
+  const WindowPrediction vc = predict_windows(pv, current, gain, options.window, band.rest_speed);
+  result.validation = DriveScores{pv.name, static_cast<int>(pv.size()), rn, rc, vn.rms, vc.rms, vn.windows};
+  result.validation_t = pv.t;
+  result.validation_position = pv.q;
+  result.validation_nominal = vn.x;
+  result.validation_corrected = vc.x;
+  result.validation_window_starts = vn.starts;
+}
+
+// The model as given in the file, in the workflow's parameters.
+Theta given_theta(const numeric::Parameters& given, const numeric::Effects& file_effects) {
+  Theta m;
+  m[kJ] = given.Jm + given.JL;
+  m[kF] = given.Fm + given.FL;
+  m[kTc] = file_effects.coulomb_motor + file_effects.coulomb_load;
+  m[kT0] = file_effects.torque_offset;
+  m[kL] = file_effects.saturation;
+  m[kTau] = file_effects.delay;
+  return m;
+}
+
+// The estimation record up to t_end, uniformly sampled.
+std::size_t samples_before(const measurements::MeasuredRecord& data, double t_end, double& fs) {
+  std::size_t n = data.size();
+  while (n > 0 && data.t[n - 1] > t_end) --n;
+  if (n < 200) throw std::invalid_argument(data.source.string() + ": fewer than 200 samples before t_end: too short for inverse dynamics");
+  const std::vector<double> t(data.t.begin(), data.t.begin() + static_cast<std::ptrdiff_t>(n));
+  try {
+    fs = measurements::uniform_sample_rate(t);
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument(data.source.string() + ": t: " + error.what());
+  }
+  return n;
+}
+
+}  // namespace
+
+DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const measurements::MeasuredRecord& data,
+                                              const DriveOptions& options, const measurements::MeasuredRecord* validation) {
+  const auto started = std::chrono::steady_clock::now();
+  const std::string where = spec.source.filename().string();
+  check_drive_inputs(spec, where, data, validation);
+  const double gain = model::to_double(spec.experiment->drive_gain);
+  const double t_end = spec.experiment->t_end ? model::to_double(*spec.experiment->t_end) : INFINITY;
+  DriveDiscrepancyResult result;
+  result.given = numeric::parameters_of(spec);
+  const numeric::Effects file_effects = numeric::effects_of(spec);
+  (void)numeric::rigid_drive_of(result.given, file_effects, gain);  // refuses effects that need a gap
+  std::vector<std::pair<std::string, int>> free_names;
+  const FreeSet nominal_free = nominal_free_of(spec, where, free_names);
+
+  double fs = 0;
+  const std::size_t n = samples_before(data, t_end, fs);
+  const std::vector<double> q(data.theta_out.begin(), data.theta_out.begin() + static_cast<std::ptrdiff_t>(n));
+  std::vector<double> u(n);
+  for (std::size_t i = 0; i < n; ++i) u[i] = gain * (*data.drive)[i];
+  const Band band = band_of(q, u, fs, options, result);
+  const Prepared p = prepare(data.source.filename().string(), data, gain, t_end, band, fs, options.holdout_fraction);
+  Work w{p, band, ranges_of(p)};
+
+  // The model as given, then the best nominal model.
+  const Theta given = given_theta(result.given, file_effects);
+  result.rms_given = rms_compared(p, residuals_of(p, band, given));
+  Theta nominal = given;
+  if (nominal_free.count() > 0) {
+    const Linear l = fit(w, given, nominal_free, p.all);
+    if (!l.ok)
+      throw std::invalid_argument(where + ": fit.free: the free nominal parameters do not fit the record to a physical drive (J > 0, F >= 0)");
+    const Polished polished = polish(w, l.m, nominal_free);
+    nominal = polished.m;
+    result.nominal_fit = named_nominal(result.given, free_names, nominal, polished.sigma);
+  }
+  result.nominal = as_parameters(result.given, free_names, nominal);
+  const std::vector<double> r_nominal = residuals_of(p, band, nominal);
+  result.rms_before = rms_compared(p, r_nominal);
+  result.tau_int_before = tau_int_compared(p, r_nominal);
+  result.noise = noise_level(fs, band, result.drive_noise, result.position_noise, nominal);
+
+  // Rounds: every remaining candidate added to the current model, fitted on the fitted blocks.
+  Theta current = nominal;
+  FreeSet current_free = nominal_free;
+  std::vector<std::string> remaining = remaining_candidates(options, given);
+  while (static_cast<int>(result.effects.size()) < options.max_effects && !remaining.empty())
+    if (!search_round(w, options, result.noise, current, current_free, remaining, result)) break;
+
+  // The corrected model: everything free polished together; uncertainties.
+  if (!result.effects.empty()) {
+    const Polished polished = polish(w, current, current_free);
+    current = polished.m;
+    for (Candidate& c : result.effects) {
+      const int which = index_of_effect(c.effect);
+      c.parameters = {{kEffectParameter[which], current[which], polished.sigma[which]}};
+    }
+    result.corrected_nominal = named_nominal(result.given, free_names, current, polished.sigma);
+  }
+  result.parameters = as_parameters(result.given, free_names, current);
+  result.corrected_effects = file_effects;
+  result.corrected_effects.coulomb_motor = current[kTc] - file_effects.coulomb_load;
+  result.corrected_effects.torque_offset = current[kT0];
+  result.corrected_effects.saturation = current[kL];
+  result.corrected_effects.delay = current[kTau];
+  const std::vector<double> r_after = residuals_of(p, band, current);
+  result.rms_after = rms_compared(p, r_after);
+  result.tau_int_after = tau_int_compared(p, r_after);
+  result.classes = classes_of(p, r_nominal, r_after);
+  result.stretches = stretches_of(p, r_nominal, r_after);
+  if (!result.effects.empty()) result.status = Status::EffectFound;
+  else if (result.rms_before <= kNoiseFactor * result.noise) result.status = Status::NoDiscrepancy;
+  else result.status = Status::Unexplained;
+
+  estimation_traces(p, band, r_nominal, r_after, nominal, current, gain, options, result);
+  if (validation) score_validation(*validation, band, fs, gain, nominal, current, options, result);
   result.least_squares = w.least_squares;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;

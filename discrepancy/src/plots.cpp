@@ -37,6 +37,34 @@ static std::vector<double> ticks(double lo, double hi) {
   return out;
 }
 
+// One series: dots (at most ~2500) or a line (at most ~3000 points; a NaN breaks it).
+template <class MapX, class MapY>
+static void draw_series(std::ostringstream& svg, const Series& s, MapX X, MapY Y) {
+  const std::size_t n = s.x->size();
+  if (s.dots) {  // at most ~2500 dots
+    const std::size_t stride = std::max<std::size_t>(1, n / 2500);
+    svg << "<g fill=\"" << s.color << "\" fill-opacity=\"0.45\">";
+    for (std::size_t i = 0; i < n; i += stride)
+      if (std::isfinite((*s.x)[i]) && std::isfinite((*s.y)[i]))
+        svg << "<circle cx=\"" << number(X((*s.x)[i])) << "\" cy=\"" << number(Y((*s.y)[i])) << "\" r=\"1.3\"/>";
+    svg << "</g>\n";
+  } else {  // at most ~3000 points; a NaN breaks the line
+    const std::size_t stride = std::max<std::size_t>(1, n / 3000);
+    bool open = false;
+    for (std::size_t i = 0; i < n; i += stride) {
+      const bool finite = std::isfinite((*s.x)[i]) && std::isfinite((*s.y)[i]);
+      if (finite && !open) {
+        svg << "<polyline fill=\"none\" stroke=\"" << s.color << "\" stroke-width=\"1.4\""
+            << (s.dashed ? " stroke-dasharray=\"6,4\"" : "") << " points=\"";
+        open = true;
+      }
+      if (finite) svg << number(X((*s.x)[i])) << "," << number(Y((*s.y)[i])) << " ";
+      if (!finite && open) svg << "\"/>\n", open = false;
+    }
+    if (open) svg << "\"/>\n";
+  }
+}
+
 std::string line_plot(const std::string& title, const std::string& xlabel, const std::string& ylabel,
                       const std::vector<Series>& series, const std::vector<Band>& bands,
                       const std::vector<std::pair<double, std::string>>& hlines) {
@@ -84,29 +112,7 @@ std::string line_plot(const std::string& title, const std::string& xlabel, const
         << "\" stroke=\"#888\" stroke-dasharray=\"2,3\"/>\n";
   int row = 0;
   for (const Series& s : series) {
-    const std::size_t n = s.x->size();
-    if (s.dots) {  // at most ~2500 dots
-      const std::size_t stride = std::max<std::size_t>(1, n / 2500);
-      svg << "<g fill=\"" << s.color << "\" fill-opacity=\"0.45\">";
-      for (std::size_t i = 0; i < n; i += stride)
-        if (std::isfinite((*s.x)[i]) && std::isfinite((*s.y)[i]))
-          svg << "<circle cx=\"" << number(X((*s.x)[i])) << "\" cy=\"" << number(Y((*s.y)[i])) << "\" r=\"1.3\"/>";
-      svg << "</g>\n";
-    } else {  // at most ~3000 points; a NaN breaks the line
-      const std::size_t stride = std::max<std::size_t>(1, n / 3000);
-      bool open = false;
-      for (std::size_t i = 0; i < n; i += stride) {
-        const bool finite = std::isfinite((*s.x)[i]) && std::isfinite((*s.y)[i]);
-        if (finite && !open) {
-          svg << "<polyline fill=\"none\" stroke=\"" << s.color << "\" stroke-width=\"1.4\""
-              << (s.dashed ? " stroke-dasharray=\"6,4\"" : "") << " points=\"";
-          open = true;
-        }
-        if (finite) svg << number(X((*s.x)[i])) << "," << number(Y((*s.y)[i])) << " ";
-        if (!finite && open) svg << "\"/>\n", open = false;
-      }
-      if (open) svg << "\"/>\n";
-    }
+    draw_series(svg, s, X, Y);
     const double ly = top + 14 + 20 * row++;
     svg << "<line x1=\"" << W - right + 12 << "\" y1=\"" << ly << "\" x2=\"" << W - right + 38 << "\" y2=\"" << ly << "\" stroke=\""
         << s.color << "\" stroke-width=\"2\"" << (s.dashed ? " stroke-dasharray=\"6,4\"" : "") << "/><text x=\"" << W - right + 44

@@ -23,7 +23,9 @@ const char* to_string(RecombinationStatus status) {
 namespace {
 
 double horizon_of(const Parameters& p, const TraceOptions& options) {
-  return options.horizon > 0 ? options.horizon : std::max(60.0, 40 * slowest_time_scale(p));
+  // In the system's own time (slowest_time_scale includes the contact period 2π√(J/K)), never a
+  // floor in seconds (a 60 s floor never bound for the thesis's cases: 40 periods of 2π s exceed it).
+  return options.horizon > 0 ? options.horizon : 40 * slowest_time_scale(p);
 }
 
 LinearWitness gap_witness(const ValidatedEvaluator& evaluator, double dtheta_m0, double level) {
@@ -35,7 +37,8 @@ LinearWitness gap_witness(const ValidatedEvaluator& evaluator, double dtheta_m0,
         x << f.theta_m, f.dtheta_m, f.theta_L, f.dtheta_L;
         return x;
       },
-      [&evaluator, dtheta_m0](double t) { return evaluator.free_state(t, dtheta_m0).gap; }, level);
+      [&evaluator, dtheta_m0](double t) { return evaluator.free_state(t, dtheta_m0).gap; }, level,
+      servo_time_unit(evaluator.parameters()));
 }
 
 // The states at the impact time point.t: motor and load before it, the recombined system after (eq. 24).
@@ -79,7 +82,7 @@ DividingLinePoint dividing_line_point(const ValidatedEvaluator& evaluator, doubl
   const LinearWitness gap = gap_witness(evaluator, v0, 0);
   const double scale = std::max({1.0, std::fabs(p.theta_R), std::fabs(evaluator.cot_phi() * v0)});
   const auto event = detail::first_gap_event(free_mode_segment(p), gap.state, gap.value, std::copysign(p.backlash, v0),
-                                             horizon_of(p, options), scale);
+                                             horizon_of(p, options), scale, servo_time_unit(p));
   if (!event) return point;
   point.status = event->kind == detail::GapEventKind::FaceLeft ? RecombinationStatus::Recontact
                                                                : RecombinationStatus::Recombination;

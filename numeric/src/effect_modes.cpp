@@ -183,10 +183,69 @@ struct ModeFlow::Generic {
 
 // ------------------------------------------------------------------ ModeFlow
 
-ModeSystem mode_system(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start,
-                       bool drive_external) {
+namespace {
+
+// The contact mode's system: z = (d, ω) with d = θo − θR − y* under the linear drive, else
+// z = (Δ, ω) with the drive as a constant (saturated) or an external input.
+void contact_system(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start,
+                    bool drive_external, ModeSystem& sys) {
   const double J = p.Jm + p.JL, F = p.Fm + p.FL;
   const double T = e.coulomb_motor + e.coulomb_load;
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  const double offset = std::fabs(e.torque_offset);
+  const double theta_o0 = measured(p, start);
+  const bool linear_drive = m.regime == 0 && !drive_external;
+  LinearSegment& s = sys.segment;
+  const double omega0 = start.dtheta_m;
+  if (m.slip_motor == 0) return;  // stuck: nothing moves
+  sys.z0_noise(1) = 4 * eps * std::fabs(omega0);
+  s.A(0, 1) = 1;
+  s.A(1, 1) = -F / J;
+  if (linear_drive) {  // z = (d, ω), d = θo − θR − y*: J d'' + F d' + K d = 0
+    const double y_star = (e.torque_offset - T * m.slip_motor) / p.K;
+    s.A(1, 0) = -p.K / J;
+    sys.z0 << theta_o0 - p.theta_R - y_star, omega0;
+    sys.z0_noise(0) = 4 * eps * (std::fabs(theta_o0) + std::fabs(p.theta_R) + (offset + T) / p.K);
+  } else {  // z = (Δ, ω): J Δ'' + F Δ' = D − T s
+    const double drive = drive_external ? 0.0 : m.regime * e.saturation + e.torque_offset;
+    s.c(1) = (drive - T * m.slip_motor) / J;
+    sys.c_magnitude(1) = ((drive_external ? 0.0 : e.saturation + offset) + T) / J;
+    if (drive_external) sys.drive_column(1) = 1 / J;
+    sys.z0 << 0, omega0;
+  }
+}
+
+// The mesh engaged on face σ: the spring-damper force couples the motor and the load rows.
+void add_mesh_coupling(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start,
+                       ModeSystem& sys) {
+  LinearSegment& s = sys.segment;
+  // σP = kc (x0 + ΔL − Δm) − σ kc b/2 + cc (θ̇L − θ̇m) acts on the motor (+σP) and the load (−σP).
+  const double kc = e.mesh_stiffness, cc = e.mesh_damping, sigma = m.face;
+  const double x0 = start.theta_L - start.theta_m;
+  const double constant = kc * x0 - sigma * kc * p.backlash / 2;
+  const double constant_magnitude = kc * (std::fabs(start.theta_L) + std::fabs(start.theta_m) + p.backlash / 2);
+  if (m.slip_motor != 0) {
+    s.A(1, 0) += -kc / p.Jm;
+    s.A(1, 1) += -cc / p.Jm;
+    s.A(1, 2) += kc / p.Jm;
+    s.A(1, 3) += cc / p.Jm;
+    s.c(1) += constant / p.Jm;
+    sys.c_magnitude(1) += constant_magnitude / p.Jm;
+  }
+  if (m.slip_load != 0) {
+    s.A(3, 0) += kc / p.JL;
+    s.A(3, 1) += cc / p.JL;
+    s.A(3, 2) += -kc / p.JL;
+    s.A(3, 3) += -cc / p.JL;
+    s.c(3) += -constant / p.JL;
+    sys.c_magnitude(3) += constant_magnitude / p.JL;
+  }
+}
+
+}  // namespace
+
+ModeSystem mode_system(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start,
+                       bool drive_external) {
   constexpr double eps = std::numeric_limits<double>::epsilon();
   const double offset = std::fabs(e.torque_offset);
   ModeSystem sys;
@@ -200,23 +259,7 @@ ModeSystem mode_system(const Parameters& p, const Effects& e, const Mode& m, con
   const double theta_o0 = measured(p, start);
   const bool linear_drive = m.regime == 0 && !drive_external;
   if (m.kind == ModeKind::Contact) {
-    const double omega0 = start.dtheta_m;
-    if (m.slip_motor == 0) return sys;  // stuck: nothing moves
-    sys.z0_noise(1) = 4 * eps * std::fabs(omega0);
-    s.A(0, 1) = 1;
-    s.A(1, 1) = -F / J;
-    if (linear_drive) {  // z = (d, ω), d = θo − θR − y*: J d'' + F d' + K d = 0
-      const double y_star = (e.torque_offset - T * m.slip_motor) / p.K;
-      s.A(1, 0) = -p.K / J;
-      sys.z0 << theta_o0 - p.theta_R - y_star, omega0;
-      sys.z0_noise(0) = 4 * eps * (std::fabs(theta_o0) + std::fabs(p.theta_R) + (offset + T) / p.K);
-    } else {  // z = (Δ, ω): J Δ'' + F Δ' = D − T s
-      const double drive = drive_external ? 0.0 : m.regime * e.saturation + e.torque_offset;
-      s.c(1) = (drive - T * m.slip_motor) / J;
-      sys.c_magnitude(1) = ((drive_external ? 0.0 : e.saturation + offset) + T) / J;
-      if (drive_external) sys.drive_column(1) = 1 / J;
-      sys.z0 << 0, omega0;
-    }
+    contact_system(p, e, m, start, drive_external, sys);
     return sys;
   }
   // Free flight and mesh: z = (Δm, θ̇m, ΔL, θ̇L).
@@ -242,29 +285,7 @@ ModeSystem mode_system(const Parameters& p, const Effects& e, const Mode& m, con
     s.c(3) = -e.coulomb_load * m.slip_load / p.JL;
     sys.c_magnitude(3) = e.coulomb_load / p.JL;
   }
-  if (m.kind == ModeKind::Mesh) {
-    // σP = kc (x0 + ΔL − Δm) − σ kc b/2 + cc (θ̇L − θ̇m) acts on the motor (+σP) and the load (−σP).
-    const double kc = e.mesh_stiffness, cc = e.mesh_damping, sigma = m.face;
-    const double x0 = start.theta_L - start.theta_m;
-    const double constant = kc * x0 - sigma * kc * p.backlash / 2;
-    const double constant_magnitude = kc * (std::fabs(start.theta_L) + std::fabs(start.theta_m) + p.backlash / 2);
-    if (m.slip_motor != 0) {
-      s.A(1, 0) += -kc / p.Jm;
-      s.A(1, 1) += -cc / p.Jm;
-      s.A(1, 2) += kc / p.Jm;
-      s.A(1, 3) += cc / p.Jm;
-      s.c(1) += constant / p.Jm;
-      sys.c_magnitude(1) += constant_magnitude / p.Jm;
-    }
-    if (m.slip_load != 0) {
-      s.A(3, 0) += kc / p.JL;
-      s.A(3, 1) += cc / p.JL;
-      s.A(3, 2) += -kc / p.JL;
-      s.A(3, 3) += -cc / p.JL;
-      s.c(3) += -constant / p.JL;
-      sys.c_magnitude(3) += constant_magnitude / p.JL;
-    }
-  }
+  if (m.kind == ModeKind::Mesh) add_mesh_coupling(p, e, m, start, sys);
   return sys;
 }
 

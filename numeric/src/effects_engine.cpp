@@ -326,7 +326,7 @@ void Engine::impact(const Exit& exit) {
 
 void Engine::count_impact() {
   impacts_.push_back(t_);
-  while (!impacts_.empty() && impacts_.front() < t_ - o_.zeno_window) impacts_.pop_front();
+  while (!impacts_.empty() && impacts_.front() < t_ - zeno_window(p_, o_)) impacts_.pop_front();
 }
 
 void Engine::transition(const Exit& exit, const Mode& m) {

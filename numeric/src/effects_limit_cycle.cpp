@@ -316,7 +316,7 @@ LimitCycle find_limit_cycle(const ValidatedEffectModel& model, const EffectLimit
     cycle.reason = "no backlash";
     return cycle;
   }
-  const double horizon = options.horizon > 0 ? options.horizon : std::max(100.0, 60 * slowest_time_scale(p));
+  const double horizon = options.horizon > 0 ? options.horizon : 60 * slowest_time_scale(p);  // as limit_cycle.cpp
   const Section section(model, horizon);
   const double velocity_scale = std::max(1.0, std::fabs(p.theta_R)) * std::sqrt(p.K / (p.Jm + p.JL));
   std::vector<std::string> outcomes;
@@ -367,7 +367,7 @@ LimitCycle find_limit_cycle(const ValidatedEffectModel& model, const EffectLimit
     cycle.reason = reason.str();
     return cycle;
   }
-  cycle.status = "limit_cycle";
+  cycle.status = CycleStatus::LimitCycle;
   cycle.stable = cycle.multiplier < 1;
   cycle.half_map_derivative = NAN;
   return cycle;

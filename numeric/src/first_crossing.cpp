@@ -12,7 +12,7 @@ namespace backlash::numeric {
 namespace {
 
 struct Sample {
-  double t, w, w1, w2, rate_norm;  // w and its first two derivatives, ‖x'(t)‖∞
+  double t, w, w1, w2, rate_norm;  // w and its first two derivatives, ‖D x'(t)‖∞
 };
 
 // The logarithmic norm μ∞(A) = max_i (a_ii + Σ_{j≠i} |a_ij|): ‖e^{At}‖∞ ≤ e^{μ∞(A) t} for t ≥ 0
@@ -30,9 +30,45 @@ double log_norm(const SmallMatrix& A) {
   return A.rows() > 0 ? mu : 0.0;
 }
 
+// A stiff segment's state mixes scales: in contact x = (θ, θ̇) with θ̇ ~ √(K/J)·θ, and A has
+// the entry K/J.  Measured in ‖·‖∞ the growth bound e^{μ∞(A) h} then allows intervals of
+// 1/μ∞(A) ~ J/K (1e-12 s for K = 1e12) where the motion's time scale is √(J/K) (1e-6 s): the
+// search bisects a million times too deep, and stops at min_interval as a false "grazing".
+// The same bound holds in any diagonally scaled norm ‖D·‖∞ (ẑ = D z obeys ẑ' = D A D⁻¹ ẑ), and
+// with D balancing A (Osborne's iteration, the LAPACK gebal rule, powers of two: exact) μ∞ is
+// √(K/J) again.  The scaling is taken only when it lowers μ∞ by more than kBalanceGain: for
+// matrices with entries of one scale (the thesis's cases) the bound, and so every interval
+// and event time, stays exactly the unscaled one.
+constexpr double kBalanceGain = 16;
+
+SmallVector balancing(const SmallMatrix& A) {
+  const Eigen::Index n = A.rows();
+  SmallVector d = SmallVector::Ones(n);
+  for (int sweep = 0; sweep < 64; ++sweep) {
+    bool changed = false;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      double c = 0, r = 0;  // off-diagonal column and row sums of D A D⁻¹
+      for (Eigen::Index j = 0; j < n; ++j) {
+        if (j == i) continue;
+        c += std::fabs(A(j, i)) * d(j) / d(i);
+        r += std::fabs(A(i, j)) * d(i) / d(j);
+      }
+      if (c == 0 || r == 0) continue;
+      const double f = std::exp2(std::round(0.5 * std::log2(c / r)));  // d_i·f balances row and column i
+      if (f != 1 && c / f + r * f < 0.95 * (c + r)) {
+        d(i) *= f;
+        changed = true;
+      }
+    }
+    if (!changed) break;
+  }
+  return d;
+}
+
 struct Witness {
   const LinearWitness& lw;
   SmallRow eA, eA2, eA3;
+  SmallVector scale;  // D: the bounds are in ‖D·‖∞
   double eAc, eA2c, mu_A, norm_c, norm_eA2, norm_eA3;
 
   explicit Witness(const LinearWitness& w) : lw(w) {
@@ -42,10 +78,23 @@ struct Witness {
     eAc = eA.dot(w.c);
     eA2c = eA2.dot(w.c);
     mu_A = log_norm(w.A);
+    scale = SmallVector::Ones(w.A.rows());
+    if (mu_A > 0) {
+      const SmallVector d = balancing(w.A);
+      const SmallMatrix balanced = d.asDiagonal() * w.A * d.cwiseInverse().asDiagonal();
+      const double mu_balanced = log_norm(balanced);
+      if (mu_balanced * kBalanceGain < mu_A) {
+        scale = d;
+        mu_A = mu_balanced;
+      }
+    }
     norm_c = w.c.cwiseAbs().maxCoeff();
-    norm_eA2 = eA2.cwiseAbs().sum();
-    norm_eA3 = eA3.cwiseAbs().sum();
+    norm_eA2 = eA2.cwiseQuotient(scale.transpose()).cwiseAbs().sum();
+    norm_eA3 = eA3.cwiseQuotient(scale.transpose()).cwiseAbs().sum();
   }
+
+  // ‖D z‖∞
+  double rate_norm(const SmallVector& z) const { return z.cwiseProduct(scale).cwiseAbs().maxCoeff(); }
 
   Sample at(double t) const {
     const SmallVector x = lw.state(t);
@@ -53,11 +102,11 @@ struct Witness {
     const double w1 = eA.dot(x) + lw.e.dot(lw.c);
     const double w2 = eA2.dot(x) + eAc;
     const SmallVector z = lw.A * x + lw.c;  // x' obeys z' = A z
-    return {t, w, w1, w2, z.cwiseAbs().maxCoeff()};
+    return {t, w, w1, w2, rate_norm(z)};
   }
 
-  // sup |w'''| on [a.t, a.t + h]: w''' = eA² z and ‖z(t)‖∞ ≤ e^{μ∞(A)(t−a)} ‖z(a)‖∞ (the
-  // supremum of e^{μ s} over s ∈ [0, h] is 1 when μ ≤ 0).
+  // sup |w'''| on [a.t, a.t + h]: w''' = eA² z = (eA² D⁻¹)(D z) and ‖D z(t)‖∞ ≤
+  // e^{μ∞(DAD⁻¹)(t−a)} ‖D z(a)‖∞ (the supremum of e^{μ s} over s ∈ [0, h] is 1 when μ ≤ 0).
   double third_bound(const Sample& a, double h) const {
     return norm_eA2 * std::exp(std::max(0.0, mu_A) * h) * a.rate_norm;
   }
@@ -70,11 +119,11 @@ bool same_sign(double x, double y) { return (x > 0 && y > 0) || (x < 0 && y < 0)
 std::optional<double> certified_departure(const LinearWitness& witness, double noise) {
   const Witness W(witness);
   const SmallVector x0 = witness.state(0);
-  const double z0 = (witness.A * x0 + witness.c).cwiseAbs().maxCoeff();  // ‖x'(0)‖, with ‖x'(t)‖ ≤ e^{‖A‖t} z0
+  const double z0 = W.rate_norm(witness.A * x0 + witness.c);  // ‖D x'(0)‖∞, with ‖D x'(t)‖∞ ≤ e^{μ t} z0
   const double second = W.eA.dot(witness.A * x0 + witness.c);           // w''(0) = eA x'(0)
   const double third = W.eA2.dot(witness.A * x0 + witness.c);           // w'''(0) = eA² x'(0)
   const double scale = std::max(std::fabs(second), 1e-300);
-  const double growth = std::max(0.0, W.mu_A);  // ‖x'(t)‖∞ ≤ e^{μ∞(A) t} z0
+  const double growth = std::max(0.0, W.mu_A);  // ‖D x'(t)‖∞ ≤ e^{μ∞(DAD⁻¹) t} z0
   // w'' dominant: |w''(0)| > t0 sup|w'''|, sup|w'''| ≤ ‖eA²‖ e^{μ t0} z0.
   if (std::fabs(second) > 1e-12 * std::max(1.0, z0)) {
     double t0 = std::sqrt(2 * noise / scale);
@@ -113,15 +162,16 @@ std::optional<Crossing> first_crossing(const LinearWitness& witness, double t_be
     const bool sign_change = !same_sign(a.w, b.w);
     if (!sign_change && std::fabs(a.w) + std::fabs(b.w) > h * M1) continue;  // excluded
     const bool monotone = same_sign(a.w1, b.w1) && 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) - h * M2) > 0;
-    if (monotone || h < options.min_interval) {
+    if (monotone || h < options.min_interval * witness.time_unit) {
       if (sign_change) {
         if (b.w == 0) return Crossing{b.t, false, examined};
         const auto f = [&](double t) { return W.at(t).w; };
         boost::uintmax_t iterations = 200;
-        const double tolerance = options.time_tolerance;
+        const double tolerance = options.time_tolerance, unit = witness.time_unit;
         const auto root = boost::math::tools::toms748_solve(
             f, a.t, b.t, a.w, b.w,
-            [tolerance](double lo, double hi) { return hi - lo <= tolerance * std::max(1.0, std::fabs(hi)); }, iterations);
+            [tolerance, unit](double lo, double hi) { return hi - lo <= tolerance * std::max(unit, std::fabs(hi)); },
+            iterations);
         return Crossing{0.5 * (root.first + root.second), false, examined};
       }
       if (monotone) continue;  // monotone without a sign change: no root

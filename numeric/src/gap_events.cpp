@@ -3,8 +3,9 @@
 namespace backlash::numeric::detail {
 
 LinearWitness gap_change_witness(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
-                                 std::function<double(double)> gap_change, double level) {
+                                 std::function<double(double)> gap_change, double level, double time_unit) {
   LinearWitness w;
+  w.time_unit = time_unit;
   w.A = free_segment.A;
   w.c = free_segment.c;
   w.e = SmallRow::Zero(4);
@@ -18,8 +19,9 @@ LinearWitness gap_change_witness(const LinearSegment& free_segment, std::functio
 
 std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
                                         std::function<double(double)> gap_change, double opposite_face_change,
-                                        double horizon, double position_scale) {
-  LinearWitness w = gap_change_witness(free_segment, std::move(state), std::move(gap_change), opposite_face_change);
+                                        double horizon, double position_scale, double time_unit) {
+  LinearWitness w =
+      gap_change_witness(free_segment, std::move(state), std::move(gap_change), opposite_face_change, time_unit);
   const std::optional<Crossing> opposite = first_crossing(w, 0, horizon);
   // Return to the face left: Δx starts as O(t²) or O(t³), below rounding noise at first.
   w.level = 0;

@@ -19,7 +19,7 @@ struct GapEvent {
 
 /// The witness of the gap change Δx = θL − θm − Δx(0) − level of a free flight.
 LinearWitness gap_change_witness(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
-                                 std::function<double(double)> gap_change, double level);
+                                 std::function<double(double)> gap_change, double level, double time_unit = 1);
 
 /// A free flight whose gap change Δx(t) = x(t) − x(0) starts at 0 with zero
 /// relative velocity.  `state` gives x(t) = (θm, θ̇m, θL, θ̇L) (any frame),
@@ -27,6 +27,6 @@ LinearWitness gap_change_witness(const LinearSegment& free_segment, std::functio
 /// `opposite_face_change` (±b) or returns to 0 (certified departure first).
 std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
                                         std::function<double(double)> gap_change, double opposite_face_change,
-                                        double horizon, double position_scale);
+                                        double horizon, double position_scale, double time_unit = 1);
 
 }  // namespace backlash::numeric::detail

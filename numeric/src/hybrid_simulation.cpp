@@ -9,6 +9,7 @@
 #include <boost/math/tools/roots.hpp>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <deque>
 #include <functional>
@@ -55,6 +56,17 @@ const char* to_string(SimulationStatus status) {
 
 bool stopped_early(SimulationStatus status) {
   return status != SimulationStatus::Completed && status != SimulationStatus::Rest;
+}
+
+double zeno_window(const Parameters& p, const SimulationOptions& options) {
+  if (options.zeno_window > 0) return options.zeno_window;
+  return zeno_time_scales / fastest_mode_rate(p);
+}
+
+std::string zeno_reason(const SimulationOptions& options, double window) {
+  char text[96];
+  std::snprintf(text, sizeof text, "%d impacts within %.3g s (Zeno)", options.zeno_impacts, window);
+  return text;
 }
 
 double measured(const Parameters& p, const HybridState& s) {
@@ -134,9 +146,14 @@ Flight flight_from_state(const Parameters& p, const HybridState& start) {
   return f;
 }
 
+// A velocity as the angle it sweeps in the servo's time unit √(J/K) (1 s for the thesis's cases):
+// the scale of a state's angles for rounding tolerances, whatever the gain.
+double swept_angle(const Parameters& p, double velocity) { return velocity * servo_time_unit(p); }
+
 bool on_separation_line(const ValidatedEvaluator& evaluator, double theta_o, double velocity) {
   const double line = evaluator.evaluator().separation_theta(velocity);
-  return std::fabs(theta_o - line) <= 1e-9 * std::max({1.0, std::fabs(theta_o), std::fabs(velocity)});
+  const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(evaluator.parameters(), velocity))});
+  return std::fabs(theta_o - line) <= 1e-9 * scale;
 }
 
 void include_state(const Parameters& p, const HybridState& h, Extremes& x) {
@@ -164,12 +181,13 @@ void segment_extremes(const Parameters& p, const LinearSegment& segment, const s
     w.e = SmallRow::Zero(n);
     w.e(row) = 1;
     w.state = vector;
+    w.time_unit = servo_time_unit(p);
     double from = 0;
     for (int k = 0; k < 10000; ++k) {
       const auto zero = first_crossing(w, from, duration);
       if (!zero) break;
       include_state(p, at(zero->t), x);
-      from = zero->t + 1e-12 * std::max(1.0, zero->t);
+      from = zero->t + 1e-12 * std::max(w.time_unit, zero->t);
       if (from >= duration) break;
     }
   }
@@ -210,194 +228,255 @@ HybridState rigid_start(const Parameters& p, const HybridState& start) {
 
 namespace {
 
-SimulationResult simulate_as_given(const ValidatedEvaluator& evaluator, const HybridState& start,
-                                   const SimulationOptions& options) {
-  const Parameters& p = evaluator.parameters();
-  SimulationResult result;
-  TrajectoryRecorder recorder(p, options, result);
-  const LinearSegment contact_segment = contact_mode_segment(p);
-  const LinearSegment free_segment = free_mode_segment(p);
-  const TransmittedTorque torque = transmitted_torque(p);
-  const bool rigid = p.backlash <= 0;  // a rigid drive: contact for ever, no events
-  HybridState state = rigid ? rigid_start(p, start) : start;
-  double t = 0;
-  std::deque<double> impacts;
-  long separations = 0;
-  auto finish = [&](SimulationStatus status) {
-    result.status = status;
-    result.t_final = t;
-    result.final_state = state;
-    result.theta_o_final = measured(p, state);
-    return result;
-  };
-  auto push_event = [&](EventKind kind, bool bounce, bool grazing) {
+// One run of the closed-form hybrid automaton from a start state: contact segments (the
+// validated closed form, separation at the first certified zero of Tc) and free flights (the
+// first certified gap event), joined by the impact law.
+class ClosedFormRun {
+ public:
+  ClosedFormRun(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options)
+      : evaluator_(evaluator),
+        p_(evaluator.parameters()),
+        o_(options),
+        recorder_(p_, options, result_),
+        contact_segment_(contact_mode_segment(p_)),
+        free_segment_(free_mode_segment(p_)),
+        torque_(transmitted_torque(p_)),
+        rigid_(p_.backlash <= 0),  // a rigid drive: contact for ever, no events
+        state_(rigid_ ? rigid_start(p_, start) : start) {}
+
+  SimulationResult run() {
+    try {
+      while (t_ < o_.t_end) {
+        if (!finite(state_)) return stop(SimulationStatus::NonFinite, "the state is no longer finite");
+        if (events_ >= o_.max_events)
+          return stop(SimulationStatus::EventLimit,
+                      "the event cap of " + std::to_string(o_.max_events) + " events was reached");
+        if (auto problem = resolution_problem(p_, motion_scale(p_, state_.theta_m, state_.theta_L), "the motion"))
+          return stop(SimulationStatus::Unresolved, *problem);
+        const std::optional<SimulationStatus> end = state_.in_contact ? contact() : flight();
+        if (end) return finish(*end);
+      }
+    } catch (const SearchBudgetExhausted& budget) {
+      return stop(SimulationStatus::WorkLimit, budget.what());
+    }
+    return finish(SimulationStatus::Completed);
+  }
+
+ private:
+  SimulationResult finish(SimulationStatus status) {
+    result_.status = status;
+    result_.t_final = t_;
+    result_.final_state = state_;
+    result_.theta_o_final = measured(p_, state_);
+    return result_;
+  }
+  SimulationResult stop(SimulationStatus status, std::string reason) {
+    result_.stop_reason = std::move(reason);
+    return finish(status);
+  }
+  void push_event(EventKind kind, bool bounce, bool grazing) {
     SimulationEvent e;
-    e.t = t;
+    e.t = t_;
     e.kind = kind;
-    e.theta_o = measured(p, state);
-    e.dtheta_o = measured_velocity(p, state);
-    e.after = state;
+    e.theta_o = measured(p_, state_);
+    e.dtheta_o = measured_velocity(p_, state_);
+    e.after = state_;
     e.bounce = bounce;
     e.grazing = grazing;
-    result.events.push_back(e);
-  };
-
-  auto stop = [&](SimulationStatus status, std::string reason) {
-    result.stop_reason = std::move(reason);
-    return finish(status);
-  };
-
-  try {
-  while (t < options.t_end) {
-    if (!finite(state)) return stop(SimulationStatus::NonFinite, "the state is no longer finite");
-    if (static_cast<long>(result.events.size()) >= options.max_events)
-      return stop(SimulationStatus::EventLimit, "the event cap of " + std::to_string(options.max_events) + " events was reached");
-    if (auto problem = resolution_problem(p, motion_scale(p, state.theta_m, state.theta_L), "the motion"))
-      return stop(SimulationStatus::Unresolved, *problem);
-    const double remaining = options.t_end - t;
-
-    if (state.in_contact) {
-      const double theta0 = measured(p, state), omega0 = state.dtheta_m;
-      LinearWitness w;
-      w.A = contact_segment.A;
-      w.c = contact_segment.c;
-      w.e = torque.r;
-      w.level = 0;  // w = Tc, given directly by `value` below (eᵀx' and its bounds need no level)
-      w.state = [&evaluator, theta0, omega0](double tau) {
-        const ContactState c = evaluator.contact_state(tau, theta0, omega0);
-        SmallVector y(2);
-        y << c.theta_o, c.dtheta_o;
-        return y;
-      };
-      // Tc = (JL K/J)(θR − θo) + (FL − JL F/J) θ̇o without the cancellation θR − θo: by
-      // linearity θo − θR = (θo0 − θR)·a(τ) + θ̇o0·b(τ) with the unit responses a, b of the
-      // validated closed form, so the rounding error scales with the motion, not with θR.
-      // Far from a zero of Tc the cancellation is harmless, so the unit responses are only
-      // evaluated where |Tc| is within a few thousand ulps of θR's scale.
-      const double cancellation_scale = 4096 * std::numeric_limits<double>::epsilon() * std::fabs(torque.r(0)) *
-                                        std::max(1.0, std::fabs(p.theta_R));
-      w.value = [&evaluator, &p, &torque, theta0, omega0, cancellation_scale](double tau) {
-        const ContactState c = evaluator.contact_state(tau, theta0, omega0);
-        const double direct = torque.r(0) * (c.theta_o - p.theta_R) + torque.r(1) * c.dtheta_o;
-        if (std::fabs(direct) > cancellation_scale) return direct;
-        const double a = evaluator.contact_state(tau, p.theta_R + 1, 0).theta_o - p.theta_R;
-        const double b = evaluator.contact_state(tau, p.theta_R, 1).theta_o - p.theta_R;
-        const double deviation = (theta0 - p.theta_R) * a + omega0 * b;
-        return torque.r(0) * deviation + torque.r(1) * c.dtheta_o;
-      };
-      const int face = state.face;
-      auto at = [&evaluator, &p, theta0, omega0, face](double tau) {
-        const ContactState c = evaluator.contact_state(tau, theta0, omega0);
-        return contact_state_on_face(p, face, c.theta_o, c.dtheta_o);
-      };
-      // The next time Tc leaves its holding sign (a grazing touch keeps contact).
-      std::optional<Crossing> separation;
-      double from = 0;
-      if (std::fabs(transmitted_torque_at(p, theta0, omega0)) <= 1e-13 * std::max(1.0, std::fabs(omega0))) {
-        // Starting on the separation line: certified departure of Tc first.
-        if (auto t0 = certified_departure(w, 1e-12)) from = *t0;
-      }
-      while (!rigid) {
-        separation = first_crossing(w, from, remaining);
-        if (!separation || !separation->grazing) break;
-        from = separation->t + 1e-12 * std::max(1.0, separation->t);
-      }
-      // Tc = r·y + r0 goes through the cancellation θR − θo: once the contact motion has decayed
-      // to rounding level its sign is noise, and a "separation" found there is spurious (e.g. an
-      // over-damped contact whose Tc = A e^{λ1 t} + B e^{λ2 t} has no zero for t > 0).  The test is
-      // on the state, not on Tc's terms: when Fm/Jm = FL/JL the velocity term of Tc vanishes
-      // identically and every genuine separation happens at θo = θR, with θ̇o far from zero.
-      if (separation) {
-        const ContactState c = evaluator.contact_state(separation->t, theta0, omega0);
-        const double noise = 1024 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(p.theta_R));
-        const double rate = std::sqrt(p.K / (p.Jm + p.JL));  // converts a velocity to a displacement scale
-        if (std::fabs(c.theta_o - p.theta_R) <= noise && std::fabs(c.dtheta_o) <= noise * rate) separation.reset();
-      }
-      auto contact_vector = [&evaluator, theta0, omega0](double tau) {
-        const ContactState c = evaluator.contact_state(tau, theta0, omega0);
-        SmallVector y(2);
-        y << c.theta_o, c.dtheta_o;
-        return y;
-      };
-      if (options.track_extremes)
-        segment_extremes(p, contact_segment, contact_vector, at, separation ? separation->t : remaining, true, result.extremes);
-      if (!separation) {
-        recorder.record(t, options.t_end + 1e-12, at);
-        state = at(remaining);
-        t = options.t_end;
-        return finish(SimulationStatus::Completed);
-      }
-      recorder.record(t, t + separation->t + 1e-12, at);
-      const HybridState at_separation = at(separation->t);
-      t += separation->t;
-      state = at_separation;
-      state.in_contact = false;  // face σ is the face just left
-      push_event(EventKind::Separation, false, false);
-      if (options.stop_after_separations > 0 && ++separations >= options.stop_after_separations)
-        return finish(SimulationStatus::Completed);
-      continue;
-    }
-
-    // Free flight.
-    const double theta_o = measured(p, state);
-    const bool from_line = std::fabs(state.dtheta_m - state.dtheta_L) <= 1e-12 * std::max(1.0, std::fabs(state.dtheta_m)) &&
-                           on_separation_line(evaluator, theta_o, state.dtheta_m);
-    const Flight flight = from_line ? flight_from_separation_line(evaluator, state) : flight_from_state(p, state);
-    const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(state.dtheta_m)});
-    const auto event =
-        detail::first_gap_event(free_segment, flight.vector, flight.gap_change, -state.face * p.backlash, remaining, scale);
-    if (options.track_extremes)
-      segment_extremes(p, free_segment, flight.vector, flight.at, event ? event->crossing.t : remaining, false, result.extremes);
-    if (!event) {
-      recorder.record(t, options.t_end + 1e-12, flight.at);
-      const HybridState end = flight.at(remaining);
-      const double speed = std::max(std::fabs(end.dtheta_m), std::fabs(end.dtheta_L));
-      if (speed < options.rest_velocity) {
-        // Rest: the last time any velocity exceeded the tolerance (bisection on the closed form).
-        double lo = 0, hi = remaining;
-        for (int i = 0; i < 200 && hi - lo > 1e-12 * std::max(1.0, hi); ++i) {
-          const double mid = 0.5 * (lo + hi);
-          bool moving = false;
-          for (int k = 0; k <= 32 && !moving; ++k) {  // any motion left in [mid, remaining]?
-            const HybridState s = flight.at(mid + (remaining - mid) * k / 32.0);
-            moving = std::max(std::fabs(s.dtheta_m), std::fabs(s.dtheta_L)) >= options.rest_velocity;
-          }
-          (moving ? lo : hi) = mid;
-        }
-        const double t_end = t + remaining;
-        t += hi;
-        state = flight.at(hi);
-        push_event(EventKind::Rest, false, false);
-        t = t_end;
-        state = end;
-        return finish(SimulationStatus::Rest);
-      }
-      state = end;
-      t = options.t_end;
-      return finish(SimulationStatus::Completed);
-    }
-    recorder.record(t, t + event->crossing.t + 1e-12, flight.at);
-    HybridState before = flight.at(event->crossing.t);
-    t += event->crossing.t;
-    // Inelastic impact (eq. 24) on the face hit.
-    const int face_hit = event->kind == detail::GapEventKind::OppositeFace ? -state.face : state.face;
-    const double omega = recombined_velocity(p, before.dtheta_m, before.dtheta_L);
-    state = contact_state_on_face(p, face_hit, measured(p, before), omega);
-    const double tc = transmitted_torque_at(p, measured(p, state), omega);
-    const bool holds = -face_hit * tc >= -1e-14 * std::max(1.0, std::fabs(tc));
-    if (!holds) state.in_contact = false;  // a bounce: the bodies part again at once
-    push_event(event->kind == detail::GapEventKind::OppositeFace ? EventKind::Recombination : EventKind::Recontact, !holds,
-               event->crossing.grazing);
-    impacts.push_back(t);
-    while (!impacts.empty() && impacts.front() < t - options.zeno_window) impacts.pop_front();
-    if (static_cast<int>(impacts.size()) >= options.zeno_impacts)
-      return stop(SimulationStatus::Chattering, std::to_string(options.zeno_impacts) + " impacts within " +
-                                                    std::to_string(options.zeno_window) + " s (Zeno)");
+    ++events_;
+    if (o_.event_sink) o_.event_sink(e);
+    else result_.events.push_back(e);
   }
-  } catch (const SearchBudgetExhausted& budget) {
-    return stop(SimulationStatus::WorkLimit, budget.what());
+
+  std::optional<SimulationStatus> contact();
+  LinearWitness contact_torque_witness(double theta0, double omega0) const;
+  std::optional<Crossing> separation(const LinearWitness& w, double theta0, double omega0, double remaining) const;
+  std::optional<SimulationStatus> flight();
+  SimulationStatus rest(const Flight& flight, double remaining, const HybridState& end);
+  std::optional<SimulationStatus> impact(const detail::GapEvent& event, const HybridState& before);
+
+  const ValidatedEvaluator& evaluator_;
+  const Parameters& p_;
+  const SimulationOptions& o_;
+  SimulationResult result_;
+  TrajectoryRecorder recorder_;
+  const LinearSegment contact_segment_, free_segment_;
+  const TransmittedTorque torque_;
+  const bool rigid_;
+  HybridState state_;
+  double t_ = 0;
+  std::deque<double> impacts_;
+  long separations_ = 0;
+  long events_ = 0;  // events so far (kept or sunk)
+};
+
+// Tc = JL θ̈o + FL θ̇o along the contact segment from (θ0, ω0), as a certified witness.
+LinearWitness ClosedFormRun::contact_torque_witness(double theta0, double omega0) const {
+  LinearWitness w;
+  w.A = contact_segment_.A;
+  w.c = contact_segment_.c;
+  w.e = torque_.r;
+  w.level = 0;  // w = Tc, given directly by `value` below (eᵀx' and its bounds need no level)
+  w.time_unit = servo_time_unit(p_);
+  const ValidatedEvaluator& evaluator = evaluator_;
+  w.state = [&evaluator, theta0, omega0](double tau) {
+    const ContactState c = evaluator.contact_state(tau, theta0, omega0);
+    SmallVector y(2);
+    y << c.theta_o, c.dtheta_o;
+    return y;
+  };
+  // Tc = (JL K/J)(θR − θo) + (FL − JL F/J) θ̇o without the cancellation θR − θo: by
+  // linearity θo − θR = (θo0 − θR)·a(τ) + θ̇o0·b(τ) with the unit responses a, b of the
+  // validated closed form, so the rounding error scales with the motion, not with θR.
+  // Far from a zero of Tc the cancellation is harmless, so the unit responses are only
+  // evaluated where |Tc| is within a few thousand ulps of θR's scale.
+  const double cancellation_scale = 4096 * std::numeric_limits<double>::epsilon() * std::fabs(torque_.r(0)) *
+                                    std::max(1.0, std::fabs(p_.theta_R));
+  w.value = [&evaluator, &p = p_, &torque = torque_, theta0, omega0, cancellation_scale](double tau) {
+    const ContactState c = evaluator.contact_state(tau, theta0, omega0);
+    const double direct = torque.r(0) * (c.theta_o - p.theta_R) + torque.r(1) * c.dtheta_o;
+    if (std::fabs(direct) > cancellation_scale) return direct;
+    const double a = evaluator.contact_state(tau, p.theta_R + 1, 0).theta_o - p.theta_R;
+    const double b = evaluator.contact_state(tau, p.theta_R, 1).theta_o - p.theta_R;
+    const double deviation = (theta0 - p.theta_R) * a + omega0 * b;
+    return torque.r(0) * deviation + torque.r(1) * c.dtheta_o;
+  };
+  return w;
+}
+
+// The next time Tc leaves its holding sign within `remaining` (a grazing touch keeps contact).
+std::optional<Crossing> ClosedFormRun::separation(const LinearWitness& w, double theta0, double omega0,
+                                                  double remaining) const {
+  std::optional<Crossing> separation;
+  double from = 0;
+  if (std::fabs(transmitted_torque_at(p_, theta0, omega0)) <= 1e-13 * std::max(1.0, std::fabs(omega0))) {
+    // Starting on the separation line: certified departure of Tc first.
+    if (auto t0 = certified_departure(w, 1e-12)) from = *t0;
   }
-  return finish(SimulationStatus::Completed);
+  while (!rigid_) {
+    separation = first_crossing(w, from, remaining);
+    if (!separation || !separation->grazing) break;
+    from = separation->t + 1e-12 * std::max(w.time_unit, separation->t);
+  }
+  // Tc = r·y + r0 goes through the cancellation θR − θo: once the contact motion has decayed
+  // to rounding level its sign is noise, and a "separation" found there is spurious (e.g. an
+  // over-damped contact whose Tc = A e^{λ1 t} + B e^{λ2 t} has no zero for t > 0).  The test is
+  // on the state, not on Tc's terms: when Fm/Jm = FL/JL the velocity term of Tc vanishes
+  // identically and every genuine separation happens at θo = θR, with θ̇o far from zero.
+  if (separation) {
+    const ContactState c = evaluator_.contact_state(separation->t, theta0, omega0);
+    const double noise = 1024 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(p_.theta_R));
+    const double rate = std::sqrt(p_.K / (p_.Jm + p_.JL));  // converts a velocity to a displacement scale
+    if (std::fabs(c.theta_o - p_.theta_R) <= noise && std::fabs(c.dtheta_o) <= noise * rate) separation.reset();
+  }
+  return separation;
+}
+
+// A contact segment on the face σ held: to the separation, or to t_end.
+std::optional<SimulationStatus> ClosedFormRun::contact() {
+  const double remaining = o_.t_end - t_;
+  const double theta0 = measured(p_, state_), omega0 = state_.dtheta_m;
+  const LinearWitness w = contact_torque_witness(theta0, omega0);
+  const int face = state_.face;
+  auto at = [&evaluator = evaluator_, &p = p_, theta0, omega0, face](double tau) {
+    const ContactState c = evaluator.contact_state(tau, theta0, omega0);
+    return contact_state_on_face(p, face, c.theta_o, c.dtheta_o);
+  };
+  const std::optional<Crossing> separated = separation(w, theta0, omega0, remaining);
+  if (o_.track_extremes)
+    segment_extremes(p_, contact_segment_, w.state, at, separated ? separated->t : remaining, true, result_.extremes);
+  if (!separated) {
+    recorder_.record(t_, o_.t_end + 1e-12, at);
+    state_ = at(remaining);
+    t_ = o_.t_end;
+    return SimulationStatus::Completed;
+  }
+  recorder_.record(t_, t_ + separated->t + 1e-12, at);
+  const HybridState at_separation = at(separated->t);
+  t_ += separated->t;
+  state_ = at_separation;
+  state_.in_contact = false;  // face σ is the face just left
+  push_event(EventKind::Separation, false, false);
+  if (o_.stop_after_separations > 0 && ++separations_ >= o_.stop_after_separations) return SimulationStatus::Completed;
+  return std::nullopt;
+}
+
+// A free flight: to the first gap event (an impact), or to t_end (at rest, or still moving).
+std::optional<SimulationStatus> ClosedFormRun::flight() {
+  const double remaining = o_.t_end - t_;
+  const double theta_o = measured(p_, state_);
+  const bool from_line = std::fabs(state_.dtheta_m - state_.dtheta_L) <= 1e-12 * std::max(1.0, std::fabs(state_.dtheta_m)) &&
+                         on_separation_line(evaluator_, theta_o, state_.dtheta_m);
+  const Flight flight = from_line ? flight_from_separation_line(evaluator_, state_) : flight_from_state(p_, state_);
+  const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(p_, state_.dtheta_m))});
+  const auto event =
+      detail::first_gap_event(free_segment_, flight.vector, flight.gap_change, -state_.face * p_.backlash, remaining, scale,
+                              servo_time_unit(p_));
+  if (o_.track_extremes)
+    segment_extremes(p_, free_segment_, flight.vector, flight.at, event ? event->crossing.t : remaining, false,
+                     result_.extremes);
+  if (!event) {
+    recorder_.record(t_, o_.t_end + 1e-12, flight.at);
+    const HybridState end = flight.at(remaining);
+    const double speed = std::max(std::fabs(end.dtheta_m), std::fabs(end.dtheta_L));
+    if (speed < o_.rest_velocity) return rest(flight, remaining, end);
+    state_ = end;
+    t_ = o_.t_end;
+    return SimulationStatus::Completed;
+  }
+  recorder_.record(t_, t_ + event->crossing.t + 1e-12, flight.at);
+  const HybridState before = flight.at(event->crossing.t);
+  t_ += event->crossing.t;
+  return impact(*event, before);
+}
+
+// Rest: the event at the last time any velocity exceeded the tolerance (bisection on the
+// closed form), then the state at t_end.
+SimulationStatus ClosedFormRun::rest(const Flight& flight, double remaining, const HybridState& end) {
+  double lo = 0, hi = remaining;
+  for (int i = 0; i < 200 && hi - lo > 1e-12 * std::max(1.0, hi); ++i) {
+    const double mid = 0.5 * (lo + hi);
+    bool moving = false;
+    for (int k = 0; k <= 32 && !moving; ++k) {  // any motion left in [mid, remaining]?
+      const HybridState s = flight.at(mid + (remaining - mid) * k / 32.0);
+      moving = std::max(std::fabs(s.dtheta_m), std::fabs(s.dtheta_L)) >= o_.rest_velocity;
+    }
+    (moving ? lo : hi) = mid;
+  }
+  const double t_end = t_ + remaining;
+  t_ += hi;
+  state_ = flight.at(hi);
+  push_event(EventKind::Rest, false, false);
+  t_ = t_end;
+  state_ = end;
+  return SimulationStatus::Rest;
+}
+
+// Inelastic impact (eq. 24) on the face hit; contact holds if the torque has its holding sign
+// there, else the bodies part again at once (a bounce).  Chattering when impacts come denser
+// than zeno_impacts in the Zeno window.
+std::optional<SimulationStatus> ClosedFormRun::impact(const detail::GapEvent& event, const HybridState& before) {
+  const bool opposite = event.kind == detail::GapEventKind::OppositeFace;
+  const int face_hit = opposite ? -state_.face : state_.face;
+  const double omega = recombined_velocity(p_, before.dtheta_m, before.dtheta_L);
+  state_ = contact_state_on_face(p_, face_hit, measured(p_, before), omega);
+  const double tc = transmitted_torque_at(p_, measured(p_, state_), omega);
+  const bool holds = -face_hit * tc >= -1e-14 * std::max(1.0, std::fabs(tc));
+  if (!holds) state_.in_contact = false;  // a bounce: the bodies part again at once
+  push_event(opposite ? EventKind::Recombination : EventKind::Recontact, !holds, event.crossing.grazing);
+  impacts_.push_back(t_);
+  const double window = zeno_window(p_, o_);
+  while (!impacts_.empty() && impacts_.front() < t_ - window) impacts_.pop_front();
+  if (static_cast<int>(impacts_.size()) >= o_.zeno_impacts) {
+    result_.stop_reason = zeno_reason(o_, window);
+    return SimulationStatus::Chattering;
+  }
+  return std::nullopt;
+}
+
+SimulationResult simulate_as_given(const ValidatedEvaluator& evaluator, const HybridState& start,
+                                   const SimulationOptions& options) {
+  return ClosedFormRun(evaluator, start, options).run();
 }
 
 void shift_state(HybridState& s, double offset) {
@@ -422,6 +501,14 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
     s.theta_m += R;
     s.theta_L += R;
   };
+  if (options.event_sink)
+    shifted.event_sink = [&options, R](const SimulationEvent& event) {
+      SimulationEvent moved = event;
+      moved.theta_o += R;
+      shift_state(moved.after, R);
+      shift_state(moved.before, R);
+      options.event_sink(moved);
+    };
   if (options.sample_sink)
     shifted.sample_sink = [&options, &shift_sample](const TrajectorySample& sample) {
       TrajectorySample moved = sample;

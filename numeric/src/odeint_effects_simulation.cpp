@@ -120,6 +120,13 @@ enum Slot { kGapA = 0, kGapB = 1, kMotor = 2, kLoad = 3, kSatA = 4, kSatB = 5 };
 constexpr double kInactive = 1.0;  // the value of an unused witness (never fires)
 constexpr int kBreakpointOrders = 4;
 constexpr long kStepBudget = 50'000'000;  // accepted steps per run: beyond, odeint has given up
+// An impact slower than this many sqrt(K/J)·max(1, b) of relative velocity is inelastic
+// whatever the restitution: the bounces it would start are below any resolved motion
+// (docs/effects.md: it ends a stick–bounce cascade).
+constexpr double kSlowestBounce = 1e-9;
+// A bounce series that ends within this fraction of the servo period 2π√(J/K) is summed
+// (one inelastic impact, then contact over τ∞) instead of simulated bounce by bounce.
+constexpr double kSeriesSummed = 1e-7;
 
 int sgn(double x) { return (x > 0) - (x < 0); }
 
@@ -362,6 +369,148 @@ struct ScanSetup {
   std::optional<int> immediate;  // fire this slot at τ = 0 without integrating
 };
 
+// What a scan has seen so far: the witnesses armed (seen inside), the last sample's probe and
+// time, and the jet at the end of the last step (the delay's history).
+struct ScanState {
+  std::array<bool, kSlots> armed;
+  Probe prev;
+  Jet jet_prev;
+  double s_prev;
+};
+
+// The witness that fires first between the last sample and the probe `pr`: an armed witness
+// crossing zero (root from `refine(slot)`), or an unarmed one found negative (it left at once,
+// or the samples missed a return: the last sample's time).  The slot, or -1.
+template <class Refine>
+int first_witness(const ScanState& seen, const Probe& pr, double& root, Refine refine) {
+  int slot = -1;
+  root = kInfinity;
+  for (int i = 0; i < kSlots; ++i) {
+    double r = kInfinity;
+    if (seen.armed[i] && seen.prev.g[i] > 0 && pr.g[i] <= 0) {
+      r = refine(i);
+    } else if (!seen.armed[i] && pr.g[i] < 0) {
+      r = seen.s_prev;
+    }
+    if (r < root) {
+      root = r;
+      slot = i;
+    }
+  }
+  return slot;
+}
+
+// ---------------------------------------------------------------- the modes, as a segment sees them
+// Rigid contact on face σ in the scan's coordinates y = (θo − θR − c, ω): the state, the
+// witnesses (separation, or the stuck band's edges; the pair's velocity; saturation) and the
+// measured shaft's jet for the delay's history.
+struct ContactMode {
+  ContactSystem system;
+  HybridState base;  // the state at the segment's start
+  int face;
+
+  HybridState at_state(const Vec2& y) const {
+    const Model& m = *system.m;
+    HybridState h = state_on_face(m.p, face, m.p.theta_R + system.c + y[0], y[1], true);
+    h.motor_stuck = base.motor_stuck;
+    h.load_stuck = base.load_stuck;
+    h.drive_regime = system.regime;
+    if (system.stuck) {
+      h.theta_m = base.theta_m;
+      h.theta_L = base.theta_L;
+    }
+    return h;
+  }
+  Probe probe(double tau, const Vec2& y) const {
+    const Model& m = *system.m;
+    Probe pr;
+    pr.g.fill(kInactive);
+    const double demand = system.demand(y, tau);
+    if (system.stuck) {
+      const double v = -face * m.drive(system.regime, demand);
+      pr.g[kMotor] = m.Tsum - v;  // pushing edge
+      pr.g[kLoad] = v + m.Tm;     // pulling edge
+    } else {
+      pr.g[kGapA] = -face * system.transmitted(y, tau);
+      if (m.Tsum > 0) pr.g[kMotor] = system.s * y[1];
+    }
+    m.saturation_witnesses(system.regime, demand, pr.g[kSatA], pr.g[kSatB]);
+    pr.v = {y[1], y[1]};
+    return pr;
+  }
+  Jet jet(double tau, const Vec2& y) const {
+    return Jet{system.m->p.theta_R + system.c + y[0], y[1], system.acceleration(y, tau)};
+  }
+};
+
+// Two bodies (free flight, or the mesh engaged) in the scan's coordinates
+// y = (θm − θm0, θ̇m, S·Δ, S·Δ̇): the state, the witnesses (the faces of the gap, or the mesh's
+// release and engagement; a body's velocity zero or breakaway; saturation), the speed above
+// rest_velocity and the measured shaft's jet.
+struct TwoBodyMode {
+  TwoBodySystem system;
+  double theta_m0, theta_L0;
+  double rest_velocity;
+
+  bool in_mesh() const { return system.mesh != 0; }
+  HybridState at_state(const Vec4& y) const {
+    HybridState h;
+    h.in_contact = in_mesh();
+    h.face = system.face;
+    h.motor_stuck = system.motor_stuck;
+    h.load_stuck = system.load_stuck;
+    h.drive_regime = system.regime;
+    h.theta_m = theta_m0 + y[0];
+    h.dtheta_m = y[1];
+    h.theta_L = system.load_stuck ? theta_L0 : theta_L0 + y[0] + y[2] / system.S;
+    h.dtheta_L = system.load_velocity(y);
+    return h;
+  }
+  Probe probe(double tau, const Vec4& y) const {
+    const Model& m = *system.m;
+    const int face = system.face, mesh = system.mesh;
+    Probe pr;
+    pr.g.fill(kInactive);
+    const double vm = y[1], vL = system.load_velocity(y);
+    const double demand = system.demand(y, tau);
+    double P = 0;
+    if (!m.compliant) {
+      const double own = face * system.gap(y) + system.off;
+      pr.g[kGapA] = own + m.p.backlash;  // ≥ 0 inside: the opposite face not reached
+      pr.g[kGapB] = -own;                // > 0 inside: the face left not reached again
+    } else if (mesh != 0) {
+      P = system.mesh_force(y, mesh);
+      pr.g[kGapA] = P;  // release when the mesh would pull
+    } else {
+      for (int side : {+1, -1}) {
+        const double d = system.penetration(y, side);
+        const double force = m.kc * d + m.cc * side * system.gap_rate(y);
+        pr.g[side > 0 ? kGapA : kGapB] = std::max(-m.kc * d, -force);
+      }
+    }
+    if (system.motor_stuck) {
+      pr.g[kMotor] = m.Tm - std::fabs(m.drive(system.regime, demand) + mesh * P);
+    } else if (m.Tm > 0) {
+      pr.g[kMotor] = system.s_m * vm;
+    }
+    if (system.load_stuck) {
+      if (mesh != 0) pr.g[kLoad] = m.TL - std::fabs(P);
+    } else if (m.TL > 0) {
+      pr.g[kLoad] = system.s_L * vL;
+    }
+    m.saturation_witnesses(system.regime, demand, pr.g[kSatA], pr.g[kSatB]);
+    pr.v = {vm, vL};
+    pr.speed = std::max(std::fabs(vm), std::fabs(vL)) - rest_velocity;
+    return pr;
+  }
+  Jet jet(double tau, const Vec4& y) const {
+    double am, aL;
+    system.accelerations(y, tau, am, aL);
+    const HybridState h = at_state(y);
+    return system.m->at_motor ? Jet{h.theta_m, h.dtheta_m, am} : Jet{h.theta_L, h.dtheta_L, aL};
+  }
+};
+
 }  // namespace
 
 // ---------------------------------------------------------------- the simulator
@@ -454,7 +603,7 @@ class Simulator {
   }
   bool count_impact() {  // true: chattering
     impacts_.push_back(t_);
-    while (!impacts_.empty() && impacts_.front() < t_ - o_.zeno_window) impacts_.pop_front();
+    while (!impacts_.empty() && impacts_.front() < t_ - zeno_window(m_.p, o_)) impacts_.pop_front();
     return static_cast<int>(impacts_.size()) >= o_.zeno_impacts;
   }
   bool separation_limit() { return o_.stop_after_separations > 0 && ++separations_ >= o_.stop_after_separations; }
@@ -495,18 +644,52 @@ class Simulator {
     st_.load_stuck = m_.TL > 0;
     s_L_ = 0;
   }
+  // The pair pulled apart at the pulling edge: a separation.
+  std::optional<SimulationStatus> pull_apart() {
+    pull_away();
+    push_event(EventKind::Separation);
+    if (separation_limit()) return SimulationStatus::Completed;
+    return std::nullopt;
+  }
+  // The drive crossing a saturation witness (slot kSatA: the upper limit, kSatB: the lower)
+  // in `regime`: it enters the limit from the linear regime, or leaves it.
+  void switch_drive_regime(int slot, int regime) {
+    const int to = regime != 0 ? 0 : slot == kSatA ? +1 : -1;
+    st_.drive_regime = to;
+    push_event(to == 0 ? EventKind::Desaturation : EventKind::Saturation);
+  }
   // Applies the static rules to the bodies at rest that are neither stuck nor decided
   // (the start, after an impact); reports stick (and separation) events.  Returns a
   // status when a stop rule fires.
   std::optional<SimulationStatus> settle();
+  bool settle_body(Body body);
 
   // ---- segments
   template <class Vector, class System, class AtState, class ProbeFn, class JetFn>
   Outcome<Vector> scan(const System& system, const Vector& y0, double horizon, double dt_max, const ScanSetup& setup,
                        AtState at_state, ProbeFn probe, JetFn jet);
+  template <class Vector, class Stepper, class System>
+  std::pair<double, double> advance(Stepper& stepper, const System& system, const std::vector<double>& stops,
+                                    std::size_t& next_stop, double t_old);
+  template <class Vector, class AtTau, class AtState, class ProbeFn>
+  bool scan_step(double ta, double tb, double dt_max, const ScanSetup& setup, ScanState& seen, Outcome<Vector>& out,
+                 AtTau at_tau, AtState at_state, ProbeFn probe);
+  ContactMode contact_mode() const;
+  ScanSetup contact_setup(const ContactMode& mode, const Vec2& y0) const;
+  bool at_rounding_level(const Vec2& y) const;
   std::optional<SimulationStatus> contact_segment();
+  std::optional<SimulationStatus> contact_event(int slot, const ContactMode& mode);
+  double face_offset(int face) const;
+  TwoBodyMode two_body_mode() const;
+  double two_body_first_step(const TwoBodyMode& mode, const Vec4& y0, double vm0, double vL0) const;
   std::optional<SimulationStatus> two_body_segment();
+  std::optional<SimulationStatus> two_body_event(const Outcome<Vec4>& out, const TwoBodyMode& mode);
+  std::optional<SimulationStatus> gap_event(int slot, const TwoBodyMode& mode);
+  void body_event(Body body, double n, bool was_stuck);
   std::optional<SimulationStatus> impact(int face_hit, EventKind kind);
+  std::optional<SimulationStatus> bounce(int face_hit, EventKind kind);
+  std::optional<SimulationStatus> sum_bounce_series(int face_hit, double theta_o, double V, double tau_inf, int regime);
+  std::optional<SimulationStatus> inelastic_impact(int face_hit, EventKind kind);
   SimulationStatus rest_now();
 
   Model m_;
@@ -546,20 +729,13 @@ Outcome<Vector> Simulator::scan(const System& system, const Vector& y0, double h
   out.y = y0;
   out.y_rest = y0;
   const double t0 = t_;
-  const double spacing = dt_max / std::max(1, oo_.interior_checks + 1);
-  auto samples_in = [spacing](double ta, double tb) {
-    const double n = std::ceil((tb - ta) / spacing * (1 - 1e-12));
-    return !(n > 1) ? 1 : n > 1e6 ? 1000000 : static_cast<int>(n);
-  };
   include(at_state(0.0, y0));
   if (setup.immediate) {
     out.slot = *setup.immediate;
     recorder_.record(t0, t0 + 1e-12, [&](double) { return at_state(0.0, y0); });
     return out;
   }
-  std::array<bool, kSlots> armed = setup.armed;
-  Probe prev = probe(0.0, y0);
-  Jet jet_prev = m_.delayed ? jet(0.0, y0) : Jet{};
+  ScanState seen{setup.armed, probe(0.0, y0), m_.delayed ? jet(0.0, y0) : Jet{}, 0.0};
   const std::vector<double> stops = local_stops(t0, horizon);
   std::size_t next_stop = 0;
 
@@ -569,19 +745,8 @@ Outcome<Vector> Simulator::scan(const System& system, const Vector& y0, double h
   if (!stops.empty()) dt0 = std::min(dt0, stops.front());
   stepper.initialize(y0, 0.0, dt0);
   double t_old = 0;
-  bool done = false;
-  while (!done && t_old < horizon) {
-    if (next_stop < stops.size() && stepper.current_time() + stepper.current_time_step() > stops[next_stop]) {
-      const Vector here = stepper.current_state();
-      stepper.initialize(here, t_old, stops[next_stop] - t_old);
-    }
-    const auto step = stepper.do_step(system);
-    if (!finite(stepper.current_state()) || !std::isfinite(step.second)) throw NonFiniteState{};
-    // A step that no longer advances time, or an absurd number of them: odeint gives up.
-    if (!(step.second > step.first) || ++steps_ > kStepBudget) throw NonFiniteState{};
-    while (next_stop < stops.size() &&
-           stops[next_stop] <= step.second + 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, step.second))
-      ++next_stop;
+  while (t_old < horizon) {
+    const auto step = advance<Vector>(stepper, system, stops, next_stop, t_old);
     const double ta = t_old, tb = std::min(step.second, horizon);
     auto at_tau = [&](double tau) {
       Vector z;
@@ -591,70 +756,118 @@ Outcome<Vector> Simulator::scan(const System& system, const Vector& y0, double h
     auto samples_upto = [&](double upto) {
       recorder_.record(t0, upto, [&](double tau) { return at_state(tau, at_tau(tau)); });
     };
-    double s_prev = ta;
-    const int n = samples_in(ta, tb);
-    for (int k = 1; k <= n; ++k) {
-      const double s = sample_time(ta, tb, k, n);
-      const Vector y = at_tau(s);
-      const Probe pr = probe(s, y);
-      int slot = -1;
-      double root = kInfinity;
-      for (int i = 0; i < kSlots; ++i) {
-        double r = kInfinity;
-        if (armed[i] && prev.g[i] > 0 && pr.g[i] <= 0) {
-          r = refine_root([&](double tau) { return probe(tau, at_tau(tau)).g[i]; }, s_prev, s, prev.g[i], pr.g[i]);
-        } else if (!armed[i] && pr.g[i] < 0) {
-          r = s_prev;  // never seen inside: it left at once (or the samples missed a return)
-        }
-        if (r < root) {
-          root = r;
-          slot = i;
-        }
-      }
-      const double until = slot >= 0 ? root : s;
-      const Vector y_until = slot >= 0 ? at_tau(root) : y;
-      const Probe pr_until = slot >= 0 ? probe(root, y_until) : pr;
-      for (int j = 0; j < setup.velocities; ++j) {
-        const double va = prev.v[j], vb = pr_until.v[j];
-        if (o_.track_extremes && ((va < 0 && vb >= 0) || (va > 0 && vb <= 0))) {
-          const double z = refine_root([&](double tau) { return probe(tau, at_tau(tau)).v[j]; }, s_prev, until, va, vb);
-          include(at_state(z, at_tau(z)));
-        }
-      }
-      if (slot >= 0) {
-        out.slot = slot;
-        out.tau = root;
-        out.y = y_until;
-        samples_upto(t0 + root + 1e-12);
-        if (m_.delayed) history_.push(t0 + ta, t0 + root, jet_prev, jet(root, y_until));
-        return out;
-      }
-      for (int i = 0; i < kSlots; ++i)
-        if (!armed[i] && pr.g[i] > 0) armed[i] = true;
-      if (setup.rest_bookkeeping && prev.speed >= 0 && pr.speed < 0) {
-        out.rest_tau = refine_root([&](double tau) { return probe(tau, at_tau(tau)).speed; }, s_prev, s, prev.speed,
-                                   pr.speed);
-        out.y_rest = at_tau(out.rest_tau);
-      }
-      prev = pr;
-      s_prev = s;
+    seen.s_prev = ta;
+    if (scan_step(ta, tb, dt_max, setup, seen, out, at_tau, at_state, probe)) {
+      samples_upto(t0 + out.tau + 1e-12);
+      if (m_.delayed) history_.push(t0 + ta, t0 + out.tau, seen.jet_prev, jet(out.tau, out.y));
+      return out;
     }
     const bool last = tb >= horizon;
     samples_upto(t0 + tb + (last ? 1e-12 : 0.0));
     const Vector y_tb = last ? at_tau(horizon) : stepper.current_state();
     if (m_.delayed) {
       const Jet jb = jet(tb, y_tb);
-      history_.push(t0 + ta, t0 + tb, jet_prev, jb);
-      jet_prev = jb;
+      history_.push(t0 + ta, t0 + tb, seen.jet_prev, jb);
+      seen.jet_prev = jb;
     }
     if (last) {
       out.y = y_tb;
       out.tau = horizon;
-      done = true;
+      break;
     }
     t_old = tb;
   }
   return out;
+}
+
+// One accepted step of the dense-output stepper from t_old, shortened to land exactly on the next
+// stop (a delay breakpoint); a non-finite state, a step that no longer advances time or an
+// absurd number of steps is odeint giving up.
+template <class Vector, class Stepper, class System>
+std::pair<double, double> Simulator::advance(Stepper& stepper, const System& system, const std::vector<double>& stops,
+                                             std::size_t& next_stop, double t_old) {
+  if (next_stop < stops.size() && stepper.current_time() + stepper.current_time_step() > stops[next_stop]) {
+    const Vector here = stepper.current_state();
+    stepper.initialize(here, t_old, stops[next_stop] - t_old);
+  }
+  const auto step = stepper.do_step(system);
+  if (!finite(stepper.current_state()) || !std::isfinite(step.second)) throw NonFiniteState{};
+  if (!(step.second > step.first) || ++steps_ > kStepBudget) throw NonFiniteState{};
+  while (next_stop < stops.size() &&
+         stops[next_stop] <= step.second + 4 * std::numeric_limits<double>::epsilon() * std::max(1.0, step.second))
+    ++next_stop;
+  return {step.first, step.second};
+}
+
+// The samples of one accepted step [ta, tb] (spaced so that oo_.interior_checks fit in a step of
+// dt_max): the first witness that fires between two samples (its root refined on the interpolant)
+// ends the segment there (true, with `out` set); the extremes of the velocities and the rest
+// time are bookkept on the way.
+template <class Vector, class AtTau, class AtState, class ProbeFn>
+bool Simulator::scan_step(double ta, double tb, double dt_max, const ScanSetup& setup, ScanState& seen,
+                          Outcome<Vector>& out, AtTau at_tau, AtState at_state, ProbeFn probe) {
+  const double spacing = dt_max / std::max(1, oo_.interior_checks + 1);
+  const double count = std::ceil((tb - ta) / spacing * (1 - 1e-12));
+  const int n = !(count > 1) ? 1 : count > 1e6 ? 1000000 : static_cast<int>(count);
+  for (int k = 1; k <= n; ++k) {
+    const double s = sample_time(ta, tb, k, n);
+    const Vector y = at_tau(s);
+    const Probe pr = probe(s, y);
+    double root = kInfinity;
+    const int slot = first_witness(seen, pr, root, [&](int i) {
+      return refine_root([&](double tau) { return probe(tau, at_tau(tau)).g[i]; }, seen.s_prev, s, seen.prev.g[i], pr.g[i]);
+    });
+    const double until = slot >= 0 ? root : s;
+    const Vector y_until = slot >= 0 ? at_tau(root) : y;
+    const Probe pr_until = slot >= 0 ? probe(root, y_until) : pr;
+    for (int j = 0; j < setup.velocities && o_.track_extremes; ++j) {
+      const double va = seen.prev.v[j], vb = pr_until.v[j];
+      if ((va < 0 && vb >= 0) || (va > 0 && vb <= 0)) {
+        const double z = refine_root([&](double tau) { return probe(tau, at_tau(tau)).v[j]; }, seen.s_prev, until, va, vb);
+        include(at_state(z, at_tau(z)));
+      }
+    }
+    if (slot >= 0) {
+      out.slot = slot;
+      out.tau = root;
+      out.y = y_until;
+      return true;
+    }
+    for (int i = 0; i < kSlots; ++i)
+      if (!seen.armed[i] && pr.g[i] > 0) seen.armed[i] = true;
+    if (setup.rest_bookkeeping && seen.prev.speed >= 0 && pr.speed < 0) {
+      out.rest_tau = refine_root([&](double tau) { return probe(tau, at_tau(tau)).speed; }, seen.s_prev, s,
+                                 seen.prev.speed, pr.speed);
+      out.y_rest = at_tau(out.rest_tau);
+    }
+    seen.prev = pr;
+    seen.s_prev = s;
+  }
+  return false;
+}
+
+// One separate body at the start of a mode: a stuck body stays stuck (its Coulomb level > 0); a
+// body at rest sticks when its static torque is within its Coulomb level, else it slips toward
+// that torque.  True: it sticks now (the caller marks it, after both bodies are settled).
+bool Simulator::settle_body(Body body) {
+  const bool motor = body == Body::Motor;
+  bool& stuck = motor ? st_.motor_stuck : st_.load_stuck;
+  double& velocity = motor ? st_.dtheta_m : st_.dtheta_L;
+  int& slip = motor ? s_m_ : s_L_;
+  const double level = motor ? m_.Tm : m_.TL;
+  if (stuck && level > 0) {
+    velocity = 0;
+    slip = 0;
+    return false;
+  }
+  stuck = false;
+  slip = sgn(velocity);
+  if (velocity == 0 && level > 0) {
+    const double n = motor ? motor_static_torque() : load_static_torque();
+    if (std::fabs(n) <= level) return true;
+    slip = sgn(n);
+  }
+  return false;
 }
 
 std::optional<SimulationStatus> Simulator::settle() {
@@ -688,32 +901,9 @@ std::optional<SimulationStatus> Simulator::settle() {
     }
     return std::nullopt;
   }
-  // Separate bodies (free flight or the mesh).
-  bool motor_sticks = false, load_sticks = false;
-  if (st_.motor_stuck && m_.Tm > 0) {
-    st_.dtheta_m = 0;
-    s_m_ = 0;
-  } else {
-    st_.motor_stuck = false;
-    s_m_ = sgn(st_.dtheta_m);
-    if (st_.dtheta_m == 0 && m_.Tm > 0) {
-      const double n = motor_static_torque();
-      if (std::fabs(n) <= m_.Tm) motor_sticks = true;
-      else s_m_ = sgn(n);
-    }
-  }
-  if (st_.load_stuck && m_.TL > 0) {
-    st_.dtheta_L = 0;
-    s_L_ = 0;
-  } else {
-    st_.load_stuck = false;
-    s_L_ = sgn(st_.dtheta_L);
-    if (st_.dtheta_L == 0 && m_.TL > 0) {
-      const double n = load_static_torque();
-      if (std::fabs(n) <= m_.TL) load_sticks = true;
-      else s_L_ = sgn(n);
-    }
-  }
+  // Separate bodies (free flight or the mesh): the motor first (the load's static torque
+  // through the mesh sees the motor's velocity as settled).
+  const bool motor_sticks = settle_body(Body::Motor), load_sticks = settle_body(Body::Load);
   if (motor_sticks) st_.motor_stuck = true;
   if (load_sticks) st_.load_stuck = true;
   if (motor_sticks || load_sticks) {
@@ -732,13 +922,45 @@ SimulationStatus Simulator::rest_now() {
 }
 
 // ---- rigid contact on face σ (the pair slipping or stuck)
-std::optional<SimulationStatus> Simulator::contact_segment() {
-  const int face = st_.face;
+ContactMode Simulator::contact_mode() const {
   const bool stuck = st_.motor_stuck && st_.load_stuck;
   const int s = stuck ? 0 : s_m_;
   const int regime = st_.drive_regime;
   const double c = (regime == 0 && !stuck) ? (m_.T0 - m_.Tsum * s) / m_.p.K : 0.0;
-  const ContactSystem system{&m_, t_, regime, s, c, stuck};
+  return ContactMode{ContactSystem{&m_, t_, regime, s, c, stuck}, st_, st_.face};
+}
+
+ScanSetup Simulator::contact_setup(const ContactMode& mode, const Vec2& y0) const {
+  ScanSetup setup;
+  setup.velocities = 1;
+  const Probe p0 = mode.probe(0.0, y0);
+  for (int i = 0; i < kSlots; ++i) setup.armed[i] = p0.g[i] > 0;
+  // Starting on the separation line (Tc ≈ 0): Tc leaving toward its non-holding sign
+  // separates at once; otherwise the witness is armed once it has the holding sign.
+  if (!mode.system.stuck) {
+    setup.armed[kGapA] = true;
+    if (std::fabs(p0.g[kGapA]) <= 1e-13 * std::max(1.0, std::fabs(y0[1]))) {
+      if (-mode.face * mode.system.transmitted_rate(y0, 0.0) < 0) setup.immediate = kGapA;
+      setup.armed[kGapA] = false;
+    } else if (p0.g[kGapA] < 0) {
+      setup.immediate = kGapA;  // a contact that does not hold (a start the drive pulls apart)
+    }
+  }
+  if (converged_) setup.armed[kGapA] = true, setup.immediate.reset();
+  return setup;
+}
+
+// The rounding-level rule (as the nominal simulators): in the linear regime, a zero of Tc
+// where the motion has decayed to rounding level about θR + c is not a separation.
+bool Simulator::at_rounding_level(const Vec2& y) const {
+  const double noise = 1024 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(m_.p.theta_R));
+  const double rate = std::sqrt(m_.p.K / m_.J);
+  return std::fabs(y[0]) <= noise && std::fabs(y[1]) <= noise * rate;
+}
+
+std::optional<SimulationStatus> Simulator::contact_segment() {
+  const ContactMode mode = contact_mode();
+  const bool stuck = mode.system.stuck;
   const double remaining = o_.t_end - t_;
   double horizon = remaining;
   bool waiting = false;  // the stuck pair waits for the delayed drive to settle
@@ -746,76 +968,26 @@ std::optional<SimulationStatus> Simulator::contact_segment() {
     horizon = std::min(remaining, still_since_ + m_.tau - t_);
     waiting = horizon < remaining;
   }
-  const Vec2 y0{measured(m_.p, st_) - m_.p.theta_R - c, stuck ? 0.0 : st_.dtheta_m};
-  const HybridState base = st_;
-  auto at_state = [&](double, const Vec2& y) {
-    HybridState h = state_on_face(m_.p, face, m_.p.theta_R + c + y[0], y[1], true);
-    h.motor_stuck = base.motor_stuck;
-    h.load_stuck = base.load_stuck;
-    h.drive_regime = regime;
-    if (stuck) {
-      h.theta_m = base.theta_m;
-      h.theta_L = base.theta_L;
-    }
-    return h;
-  };
-  auto probe = [&](double tau, const Vec2& y) {
-    Probe pr;
-    pr.g.fill(kInactive);
-    const double demand = system.demand(y, tau);
-    if (stuck) {
-      const double v = -face * m_.drive(regime, demand);
-      pr.g[kMotor] = m_.Tsum - v;  // pushing edge
-      pr.g[kLoad] = v + m_.Tm;     // pulling edge
-    } else {
-      pr.g[kGapA] = -face * system.transmitted(y, tau);
-      if (m_.Tsum > 0) pr.g[kMotor] = s * y[1];
-    }
-    m_.saturation_witnesses(regime, demand, pr.g[kSatA], pr.g[kSatB]);
-    pr.v = {y[1], y[1]};
-    return pr;
-  };
-  auto jet = [&](double tau, const Vec2& y) { return Jet{m_.p.theta_R + c + y[0], y[1], system.acceleration(y, tau)}; };
-
-  ScanSetup setup;
-  setup.velocities = 1;
-  const Probe p0 = probe(0.0, y0);
-  for (int i = 0; i < kSlots; ++i) setup.armed[i] = p0.g[i] > 0;
-  // Starting on the separation line (Tc ≈ 0): Tc leaving toward its non-holding sign
-  // separates at once; otherwise the witness is armed once it has the holding sign.
-  if (!stuck) {
-    setup.armed[kGapA] = true;
-    if (std::fabs(p0.g[kGapA]) <= 1e-13 * std::max(1.0, std::fabs(y0[1]))) {
-      if (-face * system.transmitted_rate(y0, 0.0) < 0) setup.immediate = kGapA;
-      setup.armed[kGapA] = false;
-    } else if (p0.g[kGapA] < 0) {
-      setup.immediate = kGapA;  // a contact that does not hold (a start the drive pulls apart)
-    }
-  }
-  // The rounding-level rule (as the nominal simulators): in the linear regime, a zero of Tc
-  // where the motion has decayed to rounding level about θR + c is not a separation.
-  const double noise = 1024 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(m_.p.theta_R));
-  const double rate = std::sqrt(m_.p.K / m_.J);
-  auto rounding_level = [&](const Vec2& y) { return std::fabs(y[0]) <= noise && std::fabs(y[1]) <= noise * rate; };
-
-  if (converged_) setup.armed[kGapA] = true, setup.immediate.reset();
+  const Vec2 y0{measured(m_.p, st_) - m_.p.theta_R - mode.system.c, stuck ? 0.0 : st_.dtheta_m};
+  const ScanSetup setup = contact_setup(mode, y0);
+  auto at_state = [&mode](double, const Vec2& y) { return mode.at_state(y); };
   auto probe_mode = [&](double tau, const Vec2& y) {
-    Probe pr = probe(tau, y);
+    Probe pr = mode.probe(tau, y);
     if (converged_) pr.g[kGapA] = kInactive;
     return pr;
   };
-  const Outcome<Vec2> out = scan(system, y0, horizon, dt_rigid_, setup, at_state, probe_mode, jet);
-  if (out.slot == kGapA && regime == 0 && !setup.immediate && rounding_level(out.y)) {
+  auto jet = [&mode](double tau, const Vec2& y) { return mode.jet(tau, y); };
+  const Outcome<Vec2> out = scan(mode.system, y0, horizon, dt_rigid_, setup, at_state, probe_mode, jet);
+  if (out.slot == kGapA && mode.system.regime == 0 && !setup.immediate && at_rounding_level(out.y)) {
     // Not a separation: contact holds to t_end (the remaining motion is rounding noise);
     // the mode goes on from here without the separation witness.
     t_ += out.tau;
-    st_ = at_state(out.tau, out.y);
+    st_ = mode.at_state(out.y);
     converged_ = true;
     return std::nullopt;
   }
-  const double tau_event = out.tau;
-  t_ += tau_event;
-  st_ = at_state(tau_event, out.y);
+  t_ += out.tau;
+  st_ = mode.at_state(out.y);
   include(st_);
   if (out.slot < 0) {
     if (waiting) return rest_now();
@@ -823,17 +995,23 @@ std::optional<SimulationStatus> Simulator::contact_segment() {
     return SimulationStatus::Completed;
   }
   add_breakpoints(t_);
-  switch (out.slot) {
+  return contact_event(out.slot, mode);
+}
+
+// What a witness of the contact mode that fired means, applied at the current state.
+std::optional<SimulationStatus> Simulator::contact_event(int slot, const ContactMode& mode) {
+  const int face = mode.face;
+  switch (slot) {
     case kGapA: {  // separation
       on_face(face);
       st_.in_contact = false;
-      s_m_ = s_L_ = sgn(st_.dtheta_m) != 0 ? sgn(st_.dtheta_m) : s;
+      s_m_ = s_L_ = sgn(st_.dtheta_m) != 0 ? sgn(st_.dtheta_m) : mode.system.s;
       push_event(EventKind::Separation);
       if (separation_limit()) return SimulationStatus::Completed;
       return std::nullopt;
     }
     case kMotor: {
-      if (stuck) {  // the drive beyond the pushing edge: the pair moves on
+      if (mode.system.stuck) {  // the drive beyond the pushing edge: the pair moves on
         st_.motor_stuck = st_.load_stuck = false;
         s_m_ = s_L_ = -face;
         push_event(EventKind::Slip, false, Body::Both);
@@ -850,299 +1028,264 @@ std::optional<SimulationStatus> Simulator::contact_segment() {
           s_m_ = s_L_ = -face;  // an instantaneous reversal: no event
           break;
         case PairRule::Pull:
-          pull_away();
-          push_event(EventKind::Separation);
-          if (separation_limit()) return SimulationStatus::Completed;
-          break;
+          return pull_apart();
       }
       return std::nullopt;
     }
-    case kLoad: {  // stuck pair, the drive beyond the pulling edge
-      pull_away();
-      push_event(EventKind::Separation);
-      if (separation_limit()) return SimulationStatus::Completed;
-      return std::nullopt;
-    }
+    case kLoad:  // stuck pair, the drive beyond the pulling edge
+      return pull_apart();
     case kSatA:
-    case kSatB: {
-      const int to = regime != 0 ? 0 : out.slot == kSatA ? +1 : -1;
-      st_.drive_regime = to;
-      push_event(to == 0 ? EventKind::Desaturation : EventKind::Saturation);
+    case kSatB:
+      switch_drive_regime(slot, mode.system.regime);
       return std::nullopt;
-    }
     default:
       return std::nullopt;
   }
 }
 
 // ---- two bodies: free flight or the mesh engaged
-std::optional<SimulationStatus> Simulator::two_body_segment() {
-  const int face = st_.face;
-  const int mesh = mesh_engaged() ? face : 0;
-  const bool motor_stuck = st_.motor_stuck, load_stuck = st_.load_stuck;
-  const bool both_stuck = motor_stuck && load_stuck;
-  const int regime = st_.drive_regime;
-  const double half = m_.p.backlash / 2, S = oo_.gap_scale;
+// σ·x − b/2 at the current state: how far the gap is beyond face σ (≤ 0 inside the backlash),
+// as the integrator or the impact law left it; on the face up to rounding (of the gap, and of
+// positions far from 0), a rigid mesh is exactly on it.
+double Simulator::face_offset(int face) const {
+  const double half = m_.p.backlash / 2;
   const double x0 = st_.theta_L - st_.theta_m;
   double off = face * x0 - half;
   if (penetration_.known) off = penetration_.face == face ? penetration_.delta : -penetration_.delta - m_.p.backlash;
-  // On the face up to rounding (of the gap, and of positions far from 0): exactly on it.
   const double snap = std::max(1e-12 * std::max(1.0, m_.p.backlash),
                                16 * std::numeric_limits<double>::epsilon() *
                                    std::max(std::fabs(st_.theta_m), std::fabs(st_.theta_L)));
   if (!m_.compliant && std::fabs(off) <= snap) off = 0;
-  const TwoBodySystem system{&m_,        t_,         regime, measured(m_.p, st_) - m_.p.theta_R, S, motor_stuck,
-                             load_stuck, s_m_,       s_L_,   mesh,                               face, off};
-  const double vm0 = motor_stuck ? 0.0 : st_.dtheta_m, vL0 = load_stuck ? 0.0 : st_.dtheta_L;
-  const Vec4 y0{0, vm0, 0, S * (vL0 - vm0)};
-  const double theta_m0 = st_.theta_m, theta_L0 = st_.theta_L;
+  return off;
+}
+
+TwoBodyMode Simulator::two_body_mode() const {
+  const int face = st_.face;
+  const int mesh = mesh_engaged() ? face : 0;
+  const TwoBodySystem system{&m_,          t_,           st_.drive_regime, measured(m_.p, st_) - m_.p.theta_R,
+                             oo_.gap_scale, st_.motor_stuck, st_.load_stuck, s_m_, s_L_, mesh, face, face_offset(face)};
+  return TwoBodyMode{system, st_.theta_m, st_.theta_L, o_.rest_velocity};
+}
+
+// A gap that leaves the face with Δ'' inward and Δ''' outward turns back after about
+// 3|Δ''/Δ'''|: the first step is kept below that so its samples see the excursion.
+// Likewise a gap leaving inward with Δ' and pressed back by Δ'' returns after 2|Δ'/Δ''|
+// (a bounce), and a released mesh whose force P (Ṗ < 0, P̈ > 0) comes back after 2|Ṗ/P̈|:
+// the first step is kept to a quarter of that.  0: no such bound.
+double Simulator::two_body_first_step(const TwoBodyMode& mode, const Vec4& y0, double vm0, double vL0) const {
+  const TwoBodySystem& system = mode.system;
+  const int face = system.face, regime = system.regime;
+  double am, aL;
+  system.accelerations(y0, 0.0, am, aL);
+  const double drive_rate = regime != 0 ? 0.0
+                            : m_.delayed ? m_.delayed_demand_rate(t_)
+                                         : -m_.p.K * (m_.at_motor ? y0[1] : system.load_velocity(y0));
+  const double jm = system.motor_stuck ? 0.0 : (drive_rate - m_.p.Fm * am) / m_.p.Jm;
+  const double jL = system.load_stuck ? 0.0 : -m_.p.FL * aL / m_.p.JL;
+  const double first = vL0 - vm0, second = aL - am, third = jL - jm;  // the gap's derivatives
+  if (!m_.compliant) {
+    if (y0[3] == 0) {
+      if (face * second < 0 && face * third > 0) return 0.5 * std::fabs(second / third);
+    } else if (face * first < 0 && face * second > 0) {
+      return 0.5 * std::fabs(first / second);
+    }
+  } else if (system.off > -1e-9 * std::max(1.0, m_.p.backlash)) {  // just released (or at the face)
+    const double P1 = face * (m_.kc * first + m_.cc * second), P2 = face * (m_.kc * second + m_.cc * third);
+    if (P1 < 0 && P2 > 0) return 0.5 * std::fabs(P1 / P2);
+  }
+  return 0;
+}
+
+std::optional<SimulationStatus> Simulator::two_body_segment() {
+  const TwoBodyMode mode = two_body_mode();
+  const TwoBodySystem& system = mode.system;
+  const double vm0 = system.motor_stuck ? 0.0 : st_.dtheta_m, vL0 = system.load_stuck ? 0.0 : st_.dtheta_L;
+  const Vec4 y0{0, vm0, 0, system.S * (vL0 - vm0)};
   const double remaining = o_.t_end - t_;
   double horizon = remaining;
   bool waiting = false;
-  if (both_stuck) {
+  if (system.motor_stuck && system.load_stuck) {
     horizon = std::min(remaining, still_since_ + m_.tau - t_);
     waiting = horizon < remaining;
   }
-  const bool in_mesh = mesh != 0;
-  auto at_state = [&](double, const Vec4& y) {
-    HybridState h;
-    h.in_contact = in_mesh;
-    h.face = face;
-    h.motor_stuck = motor_stuck;
-    h.load_stuck = load_stuck;
-    h.drive_regime = regime;
-    h.theta_m = theta_m0 + y[0];
-    h.dtheta_m = y[1];
-    h.theta_L = load_stuck ? theta_L0 : theta_L0 + y[0] + y[2] / S;
-    h.dtheta_L = system.load_velocity(y);
-    return h;
-  };
-  auto probe = [&](double tau, const Vec4& y) {
-    Probe pr;
-    pr.g.fill(kInactive);
-    const double vm = y[1], vL = system.load_velocity(y);
-    const double demand = system.demand(y, tau);
-    double P = 0;
-    if (!m_.compliant) {
-      const double own = face * system.gap(y) + off;
-      pr.g[kGapA] = own + m_.p.backlash;  // ≥ 0 inside: the opposite face not reached
-      pr.g[kGapB] = -own;                 // > 0 inside: the face left not reached again
-    } else if (in_mesh) {
-      P = system.mesh_force(y, mesh);
-      pr.g[kGapA] = P;  // release when the mesh would pull
-    } else {
-      for (int side : {+1, -1}) {
-        const double d = system.penetration(y, side);
-        const double force = m_.kc * d + m_.cc * side * system.gap_rate(y);
-        pr.g[side > 0 ? kGapA : kGapB] = std::max(-m_.kc * d, -force);
-      }
-    }
-    if (motor_stuck) {
-      pr.g[kMotor] = m_.Tm - std::fabs(m_.drive(regime, demand) + mesh * P);
-    } else if (m_.Tm > 0) {
-      pr.g[kMotor] = s_m_ * vm;
-    }
-    if (load_stuck) {
-      if (in_mesh) pr.g[kLoad] = m_.TL - std::fabs(P);
-    } else if (m_.TL > 0) {
-      pr.g[kLoad] = s_L_ * vL;
-    }
-    m_.saturation_witnesses(regime, demand, pr.g[kSatA], pr.g[kSatB]);
-    pr.v = {vm, vL};
-    pr.speed = std::max(std::fabs(vm), std::fabs(vL)) - o_.rest_velocity;
-    return pr;
-  };
-  auto jet = [&](double tau, const Vec4& y) {
-    double am, aL;
-    system.accelerations(y, tau, am, aL);
-    const HybridState h = at_state(tau, y);
-    return m_.at_motor ? Jet{h.theta_m, h.dtheta_m, am} : Jet{h.theta_L, h.dtheta_L, aL};
-  };
-
   ScanSetup setup;
-  setup.rest_bookkeeping = !in_mesh;
-  const Probe p0 = probe(0.0, y0);
+  setup.rest_bookkeeping = !mode.in_mesh();
+  const Probe p0 = mode.probe(0.0, y0);
   for (int i = 0; i < kSlots; ++i) setup.armed[i] = p0.g[i] > 0;
-  // A gap that leaves the face with Δ'' inward and Δ''' outward turns back after about
-  // 3|Δ''/Δ'''|: the first step is kept below that so its samples see the excursion.
-  // Likewise a gap leaving inward with Δ' and pressed back by Δ'' returns after 2|Δ'/Δ''|
-  // (a bounce), and a released mesh whose force P (Ṗ < 0, P̈ > 0) comes back after 2|Ṗ/P̈|:
-  // the first step is kept to a quarter of that.
-  if (!in_mesh && (m_.compliant || off == 0)) {
-    double am, aL;
-    system.accelerations(y0, 0.0, am, aL);
-    const double drive_rate = regime != 0 ? 0.0
-                              : m_.delayed ? m_.delayed_demand_rate(t_)
-                                           : -m_.p.K * (m_.at_motor ? y0[1] : system.load_velocity(y0));
-    const double jm = motor_stuck ? 0.0 : (drive_rate - m_.p.Fm * am) / m_.p.Jm;
-    const double jL = load_stuck ? 0.0 : -m_.p.FL * aL / m_.p.JL;
-    const double first = vL0 - vm0, second = aL - am, third = jL - jm;  // the gap's derivatives
-    if (!m_.compliant) {
-      if (y0[3] == 0) {
-        if (face * second < 0 && face * third > 0) setup.first_step = 0.5 * std::fabs(second / third);
-      } else if (face * first < 0 && face * second > 0) {
-        setup.first_step = 0.5 * std::fabs(first / second);
-      }
-    } else if (off > -1e-9 * std::max(1.0, m_.p.backlash)) {  // just released (or at the face)
-      const double P1 = face * (m_.kc * first + m_.cc * second), P2 = face * (m_.kc * second + m_.cc * third);
-      if (P1 < 0 && P2 > 0) setup.first_step = 0.5 * std::fabs(P1 / P2);
-    }
-  }
-  const double dt_max = in_mesh ? dt_mesh_ : dt_rigid_;
-  const Outcome<Vec4> out = scan(system, y0, horizon, dt_max, setup, at_state, probe, jet);
+  if (!mode.in_mesh() && (m_.compliant || system.off == 0)) setup.first_step = two_body_first_step(mode, y0, vm0, vL0);
+  auto at_state = [&mode](double, const Vec4& y) { return mode.at_state(y); };
+  auto probe = [&mode](double tau, const Vec4& y) { return mode.probe(tau, y); };
+  auto jet = [&mode](double tau, const Vec4& y) { return mode.jet(tau, y); };
+  const Outcome<Vec4> out = scan(system, y0, horizon, mode.in_mesh() ? dt_mesh_ : dt_rigid_, setup, at_state, probe, jet);
+  t_ += out.tau;
+  st_ = mode.at_state(out.y);
   if (out.slot < 0) {
-    t_ += out.tau;
-    st_ = at_state(out.tau, out.y);
     include(st_);
     if (waiting) return rest_now();
     t_ = o_.t_end;
-    if (!in_mesh && probe(out.tau, out.y).speed < 0) {
+    if (!mode.in_mesh() && mode.probe(out.tau, out.y).speed < 0) {
       const HybridState end = st_;
-      st_ = at_state(out.rest_tau, out.y_rest);
+      st_ = mode.at_state(out.y_rest);
       push_event(EventKind::Rest, false, Body::None, false, t_ - remaining + out.rest_tau);
       st_ = end;
       return SimulationStatus::Rest;
     }
     return SimulationStatus::Completed;
   }
-  const double tau_event = out.tau;
-  t_ += tau_event;
-  st_ = at_state(tau_event, out.y);
-  on_face(face, face * system.gap(out.y) + off);
+  on_face(system.face, system.face * system.gap(out.y) + system.off);
   add_breakpoints(t_);
+  return two_body_event(out, mode);
+}
+
+// What a witness of the two-body mode that fired means, applied at the current state.
+std::optional<SimulationStatus> Simulator::two_body_event(const Outcome<Vec4>& out, const TwoBodyMode& mode) {
+  const TwoBodySystem& system = mode.system;
+  const int mesh = system.mesh;
   switch (out.slot) {
     case kGapA:
-    case kGapB: {
-      if (!m_.compliant) {
-        include(st_);
-        return impact(out.slot == kGapA ? -face : face, out.slot == kGapA ? EventKind::Recombination : EventKind::Recontact);
-      }
-      if (in_mesh) {  // the mesh would pull: release
-        st_.in_contact = false;
-        push_event(EventKind::Separation);
-        if (separation_limit()) return SimulationStatus::Completed;
-        return std::nullopt;
-      }
-      const int side = out.slot == kGapA ? +1 : -1;
-      st_.in_contact = true;
-      st_.face = side;
-      push_event(side == face ? EventKind::Recontact : EventKind::Recombination);
-      if (count_impact()) return SimulationStatus::Chattering;
+    case kGapB:
+      return gap_event(out.slot, mode);
+    case kMotor:
+      body_event(Body::Motor, system.drive(out.y, out.tau) + mesh * (mode.in_mesh() ? system.mesh_force(out.y, mesh) : 0.0),
+                 system.motor_stuck);
       return std::nullopt;
-    }
-    case kMotor: {
-      const double n = system.drive(out.y, tau_event) + mesh * (in_mesh ? system.mesh_force(out.y, mesh) : 0.0);
-      if (motor_stuck) {  // breakaway
-        st_.motor_stuck = false;
-        s_m_ = sgn(n);
-        push_event(EventKind::Slip, false, Body::Motor);
-        return std::nullopt;
-      }
-      st_.dtheta_m = 0;
-      if (std::fabs(n) <= m_.Tm) {
-        st_.motor_stuck = true;
-        s_m_ = 0;
-        push_event(EventKind::Stick, false, Body::Motor);
-      } else {
-        s_m_ = sgn(n);  // reversal: no event
-      }
+    case kLoad:
+      body_event(Body::Load, mode.in_mesh() ? -mesh * system.mesh_force(out.y, mesh) : 0.0, system.load_stuck);
       return std::nullopt;
-    }
-    case kLoad: {
-      const double n = in_mesh ? -mesh * system.mesh_force(out.y, mesh) : 0.0;
-      if (load_stuck) {
-        st_.load_stuck = false;
-        s_L_ = sgn(n);
-        push_event(EventKind::Slip, false, Body::Load);
-        return std::nullopt;
-      }
-      st_.dtheta_L = 0;
-      if (std::fabs(n) <= m_.TL) {
-        st_.load_stuck = true;
-        s_L_ = 0;
-        push_event(EventKind::Stick, false, Body::Load);
-      } else {
-        s_L_ = sgn(n);
-      }
-      return std::nullopt;
-    }
     case kSatA:
-    case kSatB: {
-      const int to = regime != 0 ? 0 : out.slot == kSatA ? +1 : -1;
-      st_.drive_regime = to;
-      push_event(to == 0 ? EventKind::Desaturation : EventKind::Saturation);
+    case kSatB:
+      switch_drive_regime(out.slot, system.regime);
       return std::nullopt;
-    }
     default:
       return std::nullopt;
   }
 }
 
+// The gap reaching a face (slot kGapA: the opposite face −σ, or with compliance the face +1;
+// kGapB: the face σ left, or −1): a rigid impact, the mesh released, or the mesh engaging.
+std::optional<SimulationStatus> Simulator::gap_event(int slot, const TwoBodyMode& mode) {
+  const int face = mode.system.face;
+  if (!m_.compliant) {
+    include(st_);
+    return impact(slot == kGapA ? -face : face, slot == kGapA ? EventKind::Recombination : EventKind::Recontact);
+  }
+  if (mode.in_mesh()) {  // the mesh would pull: release
+    st_.in_contact = false;
+    push_event(EventKind::Separation);
+    if (separation_limit()) return SimulationStatus::Completed;
+    return std::nullopt;
+  }
+  const int side = slot == kGapA ? +1 : -1;
+  st_.in_contact = true;
+  st_.face = side;
+  push_event(side == face ? EventKind::Recontact : EventKind::Recombination);
+  if (count_impact()) return SimulationStatus::Chattering;
+  return std::nullopt;
+}
+
+// One body's Coulomb event: a stuck body breaking away (toward its static torque n), or a
+// moving body's velocity reaching 0 — it sticks when |n| is within its Coulomb level, else it
+// reverses at once (no event).
+void Simulator::body_event(Body body, double n, bool was_stuck) {
+  const bool motor = body == Body::Motor;
+  bool& stuck = motor ? st_.motor_stuck : st_.load_stuck;
+  int& slip = motor ? s_m_ : s_L_;
+  if (was_stuck) {  // breakaway
+    stuck = false;
+    slip = sgn(n);
+    push_event(EventKind::Slip, false, body);
+    return;
+  }
+  (motor ? st_.dtheta_m : st_.dtheta_L) = 0;
+  if (std::fabs(n) <= (motor ? m_.Tm : m_.TL)) {
+    stuck = true;
+    slip = 0;
+    push_event(EventKind::Stick, false, body);
+  } else {
+    slip = sgn(n);  // reversal: no event
+  }
+}
+
 // ---- the impact on face σ_hit (rigid mesh): momentum conserved, v_rel⁺ = −e·v_rel⁻.
 std::optional<SimulationStatus> Simulator::impact(int face_hit, EventKind kind) {
+  const double v_rel = st_.dtheta_L - st_.dtheta_m;
+  on_face(face_hit);
+  // Restitution applies above the slowest bounce, 1e-9·sqrt(K/J)·max(1, b) of relative velocity;
+  // a slower impact is inelastic (docs/effects.md: it ends a stick–bounce cascade).
+  const double slowest = kSlowestBounce * std::sqrt(m_.p.K / m_.J) * std::max(1.0, m_.p.backlash);
+  if (m_.e > 0 && std::fabs(v_rel) >= slowest) return bounce(face_hit, kind);
+  return inelastic_impact(face_hit, kind);
+}
+
+// Restitution: the bodies part at once with v_rel⁺ = −e·v_rel⁻.  When the free-flight relative
+// acceleration α presses them back, the series of ever smaller bounces ends after
+// τ∞ = 2e|v_rel|/(α(1 − e)); a τ∞ below kSeriesSummed of the servo period is summed.
+std::optional<SimulationStatus> Simulator::bounce(int face_hit, EventKind kind) {
   const double Jm = m_.p.Jm, JL = m_.p.JL, J = m_.J;
   const double vm = st_.dtheta_m, vL = st_.dtheta_L;
   const double V = (Jm * vm + JL * vL) / J;
   const double v_rel = vL - vm;
   const double theta_o = measured(m_.p, st_);
   const int regime = st_.drive_regime;
-  on_face(face_hit);
-
-  // Restitution applies above the slowest bounce, 1e-9·sqrt(K/J)·max(1, b) of relative velocity;
-  // a slower impact is inelastic (docs/effects.md: it ends a stick–bounce cascade).
-  const double slowest = 1e-9 * std::sqrt(m_.p.K / J) * std::max(1.0, m_.p.backlash);
-  if (m_.e > 0 && std::fabs(v_rel) >= slowest) {
-    const double v_rel_after = -m_.e * v_rel;
-    const double vm_after = V - JL / J * v_rel_after, vL_after = V + Jm / J * v_rel_after;
-    st_ = state_on_face(m_.p, face_hit, theta_o, 0, false);
-    st_.dtheta_m = vm_after;
-    st_.dtheta_L = vL_after;
-    st_.drive_regime = regime;
-    st_.motor_stuck = st_.load_stuck = false;
-    // Free-flight relative acceleration pressing the bodies back together.
-    const double D = drive_now();
-    auto direction = [](double v, double n, double T) { return v != 0 ? sgn(v) : std::fabs(n) <= T ? 0 : sgn(n); };
-    const int sm = direction(vm_after, D, m_.Tm), sL = direction(vL_after, 0.0, m_.TL);
-    const double am = (D - m_.p.Fm * vm_after - m_.Tm * sm) / Jm;
-    const double aL = (-m_.p.FL * vL_after - m_.TL * sL) / JL;
-    const double alpha = face_hit * (aL - am);
-    const double w = m_.e * std::fabs(v_rel);
-    // A bounce series continues when the event before this impact was a bounce on this face;
-    // only then are its impacts exempt from the chattering guard (a stick-bounce cascade is not).
-    const bool continues_series = !result_.events.empty() && result_.events.back().bounce &&
-                                  (result_.events.back().kind == EventKind::Recombination ||
-                                   result_.events.back().kind == EventKind::Recontact) &&
-                                  result_.events.back().after.face == face_hit;
-    const bool converging = alpha > 0;
-    push_event(kind, true);
-    if (converging) {
-      const double tau_inf = 2 * w / (alpha * (1 - m_.e));
-      if (tau_inf <= 1e-7 * servo_period_) {
-        // The series summed: the inelastic impact at t, then the contact motion over τ∞.
-        const int s = V != 0 ? sgn(V) : 0;
-        st_ = state_on_face(m_.p, face_hit, theta_o, V, true);
-        st_.drive_regime = regime;
-        const double acc = (drive_now() - m_.F * V - m_.Tsum * s) / J;
-        const double theta_after = theta_o + V * tau_inf + 0.5 * acc * tau_inf * tau_inf;
-        const double omega_after = V + acc * tau_inf;
-        if (m_.delayed) history_.push(t_, t_ + tau_inf, Jet{theta_o, V, acc}, Jet{theta_after, omega_after, acc});
-        t_ += tau_inf;
-        st_ = state_on_face(m_.p, face_hit, theta_after, omega_after, true);
-        st_.drive_regime = regime;
-        add_breakpoints(t_);
-        push_event(EventKind::Recontact, false, Body::None, true);
-        s_m_ = s_L_ = sgn(omega_after);
-        if (omega_after == 0) return settle();
-        return std::nullopt;
-      }
-    }
-    if (!(converging && continues_series) && count_impact()) return SimulationStatus::Chattering;
-    s_m_ = sgn(vm_after);
-    s_L_ = sgn(vL_after);
-    return settle();
+  const double v_rel_after = -m_.e * v_rel;
+  const double vm_after = V - JL / J * v_rel_after, vL_after = V + Jm / J * v_rel_after;
+  st_ = state_on_face(m_.p, face_hit, theta_o, 0, false);
+  st_.dtheta_m = vm_after;
+  st_.dtheta_L = vL_after;
+  st_.drive_regime = regime;
+  st_.motor_stuck = st_.load_stuck = false;
+  // Free-flight relative acceleration pressing the bodies back together.
+  const double D = drive_now();
+  auto direction = [](double v, double n, double T) { return v != 0 ? sgn(v) : std::fabs(n) <= T ? 0 : sgn(n); };
+  const int sm = direction(vm_after, D, m_.Tm), sL = direction(vL_after, 0.0, m_.TL);
+  const double am = (D - m_.p.Fm * vm_after - m_.Tm * sm) / Jm;
+  const double aL = (-m_.p.FL * vL_after - m_.TL * sL) / JL;
+  const double alpha = face_hit * (aL - am);
+  const double w = m_.e * std::fabs(v_rel);
+  // A bounce series continues when the event before this impact was a bounce on this face;
+  // only then are its impacts exempt from the chattering guard (a stick-bounce cascade is not).
+  const bool continues_series = !result_.events.empty() && result_.events.back().bounce &&
+                                (result_.events.back().kind == EventKind::Recombination ||
+                                 result_.events.back().kind == EventKind::Recontact) &&
+                                result_.events.back().after.face == face_hit;
+  const bool converging = alpha > 0;
+  push_event(kind, true);
+  if (converging) {
+    const double tau_inf = 2 * w / (alpha * (1 - m_.e));
+    if (tau_inf <= kSeriesSummed * servo_period_) return sum_bounce_series(face_hit, theta_o, V, tau_inf, regime);
   }
+  if (!(converging && continues_series) && count_impact()) return SimulationStatus::Chattering;
+  s_m_ = sgn(vm_after);
+  s_L_ = sgn(vL_after);
+  return settle();
+}
 
-  // Inelastic impact (eq. 24): both at V; contact holds if −σ·Tc ≥ 0 there.
+// The bounce series summed: the inelastic impact at t (both at V), then the contact motion over τ∞.
+std::optional<SimulationStatus> Simulator::sum_bounce_series(int face_hit, double theta_o, double V, double tau_inf,
+                                                             int regime) {
+  const int s = V != 0 ? sgn(V) : 0;
+  st_ = state_on_face(m_.p, face_hit, theta_o, V, true);
+  st_.drive_regime = regime;
+  const double acc = (drive_now() - m_.F * V - m_.Tsum * s) / m_.J;
+  const double theta_after = theta_o + V * tau_inf + 0.5 * acc * tau_inf * tau_inf;
+  const double omega_after = V + acc * tau_inf;
+  if (m_.delayed) history_.push(t_, t_ + tau_inf, Jet{theta_o, V, acc}, Jet{theta_after, omega_after, acc});
+  t_ += tau_inf;
+  st_ = state_on_face(m_.p, face_hit, theta_after, omega_after, true);
+  st_.drive_regime = regime;
+  add_breakpoints(t_);
+  push_event(EventKind::Recontact, false, Body::None, true);
+  s_m_ = s_L_ = sgn(omega_after);
+  if (omega_after == 0) return settle();
+  return std::nullopt;
+}
+
+// Inelastic impact (eq. 24): both at V; contact holds if −σ·Tc ≥ 0 there.
+std::optional<SimulationStatus> Simulator::inelastic_impact(int face_hit, EventKind kind) {
+  const double Jm = m_.p.Jm, JL = m_.p.JL, J = m_.J;
+  const double V = (Jm * st_.dtheta_m + JL * st_.dtheta_L) / J;
+  const double theta_o = measured(m_.p, st_);
+  const int regime = st_.drive_regime;
   st_ = state_on_face(m_.p, face_hit, theta_o, V, true);
   st_.drive_regime = regime;
   st_.motor_stuck = st_.load_stuck = false;
@@ -1167,8 +1310,7 @@ std::optional<SimulationStatus> Simulator::impact(int face_hit, EventKind kind) 
     return std::nullopt;
   }
   const int s = sgn(V);
-  const double D = drive_now();
-  const double acc = (D - m_.F * V - m_.Tsum * s) / J;
+  const double acc = (drive_now() - m_.F * V - m_.Tsum * s) / J;
   const double tc = JL * acc + m_.p.FL * V + m_.TL * s;
   bool holds = -face_hit * tc >= -1e-14 * std::max(1.0, std::fabs(tc));
   if (!holds && std::fabs(tc) <= 1e-13 * std::max(1.0, std::fabs(V))) {

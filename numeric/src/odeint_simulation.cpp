@@ -181,6 +181,46 @@ inline double sample_time(double t_old, double t_new, int k, int n) {
 }
 
 
+// The contact segment's witness on face σ in the deviation y = (θo − θR, θ̇o): h = −σ·Tc (> 0
+// while contact holds), and the state.
+struct ContactWitness {
+  const Parameters& p;
+  int face;
+  double hold(const ContactVector& y) const { return -face * contact_torque_deviation(p, y[0], y[1]); }
+  HybridState at(const ContactVector& y) const { return contact_on_face(p, face, p.theta_R + y[0], y[1]); }
+};
+
+// What a contact segment's witness samples have seen: the last h and θ̇o, whether the witness
+// is armed, whether the motion has converged to rounding level, and the separation found.
+struct ContactScan {
+  double h_prev, v_prev;
+  bool armed, converged;
+  std::optional<double> separation;
+};
+
+// The free flight's witnesses in the start-relative coordinates: the opposite face reached
+// (recombination, ≥ 0 inside), the face left reached again (recontact, ≤ 0 inside), and the
+// speed above rest_velocity.
+struct FreeWitnesses {
+  int face;
+  double S, offset, backlash, rest_velocity;
+  double recombination(const FreeVector& y) const { return face * y[2] / S + offset + backlash; }
+  double recontact(const FreeVector& y) const { return face * y[2] / S + offset; }
+  double speed(const FreeVector& y) const {
+    return std::max(std::fabs(y[1]), std::fabs(y[1] + y[3] / S)) - rest_velocity;
+  }
+};
+
+// What a free flight's witness samples have seen: the last sample's witnesses and velocities,
+// whether recontact is armed, the event found and the rest time.
+struct FreeScan {
+  double r_prev, c_prev, v_prev, vm_prev, vL_prev;
+  bool armed = false;
+  std::optional<double> event_tau;
+  bool opposite = false;
+  double rest_tau = 0;
+};
+
 }  // namespace
 
 double fastest_rate(const Parameters& p) {
@@ -190,284 +230,352 @@ double fastest_rate(const Parameters& p) {
   return rate > 0 ? rate : 1.0;
 }
 
-SimulationResult simulate_with_odeint(const Parameters& p, const HybridState& start, const SimulationOptions& options,
-                                      const OdeintSimulationOptions& oo) {
-  SimulationResult result;
-  TrajectoryRecorder recorder(p, options, result);
-  const ContactSystem contact_system{p};
-  const double dt_max = oo.max_step_fraction / fastest_rate(p);
-  // Witness samples: at most dt_max / (interior_checks + 1) apart on every step (a step of
-  // dt_max gets interior_checks interior samples plus its end; shorter steps fewer).
-  const double spacing = dt_max / std::max(1, oo.interior_checks + 1);
-  auto samples_in = [spacing](double ta, double tb) {
-    return std::max(1, static_cast<int>(std::ceil((tb - ta) / spacing * (1 - 1e-12))));
-  };
-  const bool at_motor = p.measured_at == model::MeasuredAt::Motor;
-  const bool rigid = p.backlash <= 0;  // b = 0: a rigid drive, contact for ever (docs/physics.md)
-  HybridState state = rigid ? rigid_start(p, start) : start;
-  double t = 0;
-  long separations = 0;
-  std::deque<double> impacts;
+namespace {
 
-  auto finish = [&](SimulationStatus status) {
-    result.status = status;
-    result.t_final = t;
-    result.final_state = state;
-    result.theta_o_final = measured(p, state);
-    return result;
-  };
-  auto push_event = [&](EventKind kind, bool bounce) {
+// One run of the odeint hybrid simulator from a start state: contact segments integrated in
+// (θo − θR, θ̇o) up to the first zero of −σ·Tc, free flights in (θm − θm0, θ̇m, S·Δ, S·Δ̇) up to
+// the first face reached, joined by the impact law (eq. 24).  Witnesses are sampled at most
+// `spacing` apart on the dense output and their zeros refined with toms748.
+class OdeintRun {
+ public:
+  OdeintRun(const Parameters& p, const HybridState& start, const SimulationOptions& options,
+            const OdeintSimulationOptions& oo)
+      : p_(p),
+        o_(options),
+        oo_(oo),
+        recorder_(p, options, result_),
+        contact_system_{p},
+        dt_max_(oo.max_step_fraction / fastest_rate(p)),
+        // Witness samples: at most dt_max / (interior_checks + 1) apart on every step (a step of
+        // dt_max gets interior_checks interior samples plus its end; shorter steps fewer).
+        spacing_(dt_max_ / std::max(1, oo.interior_checks + 1)),
+        at_motor_(p.measured_at == model::MeasuredAt::Motor),
+        rigid_(p.backlash <= 0),  // b = 0: a rigid drive, contact for ever (docs/physics.md)
+        state_(rigid_ ? rigid_start(p, start) : start) {}
+
+  SimulationResult run() {
+    try {
+      while (t_ < o_.t_end) {
+        if (!finite(state_)) return stop(SimulationStatus::NonFinite, "the state is no longer finite");
+        if (static_cast<long>(result_.events.size()) >= o_.max_events)
+          return stop(SimulationStatus::EventLimit,
+                      "the event cap of " + std::to_string(o_.max_events) + " events was reached");
+        if (auto problem = resolution_problem(p_, motion_scale(p_, state_.theta_m, state_.theta_L), "the motion"))
+          return stop(SimulationStatus::Unresolved, *problem);
+        const std::optional<SimulationStatus> end = state_.in_contact ? contact() : flight();
+        if (end) return finish(*end);
+      }
+    } catch (const NonFiniteState&) {
+      return stop(SimulationStatus::NonFinite, "the integration produced a non-finite state");
+    } catch (const odeint::step_adjustment_error&) {
+      return stop(SimulationStatus::NonFinite, "odeint could not adjust its step");
+    } catch (const odeint::no_progress_error&) {
+      return stop(SimulationStatus::NonFinite, "odeint made no progress");
+    }
+    return finish(SimulationStatus::Completed);
+  }
+
+ private:
+  SimulationResult finish(SimulationStatus status) {
+    result_.status = status;
+    result_.t_final = t_;
+    result_.final_state = state_;
+    result_.theta_o_final = measured(p_, state_);
+    return result_;
+  }
+  SimulationResult stop(SimulationStatus status, std::string reason) {
+    result_.stop_reason = std::move(reason);
+    return finish(status);
+  }
+  void push_event(EventKind kind, bool bounce) {
     SimulationEvent e;
-    e.t = t;
+    e.t = t_;
     e.kind = kind;
-    e.theta_o = measured(p, state);
-    e.dtheta_o = at_motor ? state.dtheta_m : state.dtheta_L;
-    e.after = state;
+    e.theta_o = measured(p_, state_);
+    e.dtheta_o = at_motor_ ? state_.dtheta_m : state_.dtheta_L;
+    e.after = state_;
     e.bounce = bounce;
-    result.events.push_back(e);
-  };
-  auto include = [&](const HybridState& h) {
-    if (!options.track_extremes) return;
-    Extremes& x = result.extremes;
-    const double o = measured(p, h);
+    result_.events.push_back(e);
+  }
+  void include(const HybridState& h) {
+    if (!o_.track_extremes) return;
+    Extremes& x = result_.extremes;
+    const double o = measured(p_, h);
     x.theta_o_min = std::min(x.theta_o_min, o);
     x.theta_o_max = std::max(x.theta_o_max, o);
     x.theta_m_min = std::min(x.theta_m_min, h.theta_m);
     x.theta_m_max = std::max(x.theta_m_max, h.theta_m);
     x.theta_L_min = std::min(x.theta_L_min, h.theta_L);
     x.theta_L_max = std::max(x.theta_L_max, h.theta_L);
-  };
-  // Extremes inside a step: the zeros of a velocity between two samples, located on the interpolant.
-  auto velocity_zero = [&](double a, double b, double va, double vb, auto velocity_at) -> std::optional<double> {
-    if (!options.track_extremes || !((va < 0 && vb >= 0) || (va > 0 && vb <= 0))) return std::nullopt;
-    return refine_root(velocity_at, a, b, va, vb);
-  };
-
-  auto stop = [&](SimulationStatus status, std::string reason) {
-    result.stop_reason = std::move(reason);
-    return finish(status);
-  };
-
-  try {
-    while (t < options.t_end) {
-      if (!finite(state)) return stop(SimulationStatus::NonFinite, "the state is no longer finite");
-      if (static_cast<long>(result.events.size()) >= options.max_events)
-        return stop(SimulationStatus::EventLimit,
-                    "the event cap of " + std::to_string(options.max_events) + " events was reached");
-      if (auto problem = resolution_problem(p, motion_scale(p, state.theta_m, state.theta_L), "the motion"))
-        return stop(SimulationStatus::Unresolved, *problem);
-      const double remaining = options.t_end - t;
-      const double t0 = t;
-
-      if (state.in_contact) {
-        // ---- contact on face σ: integrate (θo − θR, θ̇o); separation at the first zero of h = −σ·Tc.
-        const int face = state.face;
-        const ContactVector y0{measured(p, state) - p.theta_R, state.dtheta_m};
-        auto hold = [&](const ContactVector& y) { return -face * contact_torque_deviation(p, y[0], y[1]); };
-        auto at_vec = [&, face](const ContactVector& y) { return contact_on_face(p, face, p.theta_R + y[0], y[1]); };
-        include(at_vec(y0));
-        double h_prev = hold(y0), v_prev = y0[1];
-        // Starting on the separation line (Tc ≈ 0): Tc leaving toward its non-holding sign
-        // separates at once; otherwise the witness is armed once it has the holding sign.
-        bool armed = !rigid, converged = rigid;
-        std::optional<double> separation;
-        if (!rigid && std::fabs(h_prev) <= 1e-13 * std::max(1.0, std::fabs(y0[1]))) {
-          if (-face * contact_torque_rate(p, y0[0], y0[1]) < 0) separation = 0.0;
-          armed = false;
-        }
-        ContactVector y_end = y0;
-        if (!separation) {
-          march(contact_system, y0, remaining, dt_max, oo.tolerance, [&](double ta, double tb, auto& stepper) {
-            auto at_tau = [&](double tau) {
-              ContactVector z;
-              stepper.calc_state(tau, z);
-              return z;
-            };
-            auto samples_upto = [&](double upto) {
-              recorder.record(t0, upto, [&](double tau) { return at_vec(at_tau(tau)); });
-            };
-            double s_prev = ta;
-            const int n = samples_in(ta, tb);
-            for (int k = 1; k <= n; ++k) {
-              const double s = sample_time(ta, tb, k, n);
-              const ContactVector y = at_tau(s);
-              const double h = hold(y);
-              std::optional<double> sep;
-              if (armed && h_prev > 0 && h <= 0) {
-                sep = refine_root([&](double tau) { return hold(at_tau(tau)); }, s_prev, s, h_prev, h);
-                if (at_rounding_level(p, at_tau(*sep))) {  // not a separation: contact holds to t_end
-                  sep.reset();
-                  armed = false;
-                  converged = true;
-                }
-              }
-              const double until = sep ? *sep : s;
-              const ContactVector y_until = sep ? at_tau(*sep) : y;
-              if (auto z = velocity_zero(s_prev, until, v_prev, y_until[1], [&](double tau) { return at_tau(tau)[1]; }))
-                include(at_vec(at_tau(*z)));
-              if (sep) {
-                separation = sep;
-                y_end = y_until;
-                samples_upto(t0 + *sep + 1e-12);
-                return true;
-              }
-              if (!armed && !converged && h > 0) armed = true;
-              h_prev = h;
-              v_prev = y[1];
-              s_prev = s;
-            }
-            const bool last = tb >= remaining;
-            samples_upto(t0 + tb + (last ? 1e-12 : 0.0));
-            if (last) y_end = at_tau(remaining);
-            return false;
-          });
-        }
-        include(at_vec(y_end));
-        if (!separation) {
-          state = at_vec(y_end);
-          t = options.t_end;
-          return finish(SimulationStatus::Completed);
-        }
-        if (*separation == 0) recorder.record(t0, t0 + 1e-12, [&](double) { return at_vec(y0); });
-        t += *separation;
-        state = at_vec(y_end);
-        state.in_contact = false;  // face σ is now the face just left
-        push_event(EventKind::Separation, false);
-        if (options.stop_after_separations > 0 && ++separations >= options.stop_after_separations)
-          return finish(SimulationStatus::Completed);
-        continue;
-      }
-
-      // ---- free flight from the face σ left: integrate (θm − θm0, θ̇m, S·Δ, S·Δ̇).
-      const int face = state.face;
-      const double half = p.backlash / 2, S = oo.gap_scale;
-      const FreeSystem free_system{p, measured(p, state) - p.theta_R, S, at_motor};
-      const FreeFrame frame{state.theta_m, state.theta_L, S, face};
-      const FreeVector y0{0, state.dtheta_m, 0, S * (state.dtheta_L - state.dtheta_m)};
-      // Where the gap starts relative to the face σ b/2 (0 when on it, up to rounding).
-      const double x0 = state.theta_L - state.theta_m;
-      const double offset =
-          std::fabs(face * x0 - half) <= 1e-12 * std::max(1.0, p.backlash) ? 0.0 : face * x0 - half;
-      auto recombination_w = [&](const FreeVector& y) { return face * y[2] / S + offset + p.backlash; };  // ≥ 0 inside
-      auto recontact_w = [&](const FreeVector& y) { return face * y[2] / S + offset; };                   // ≤ 0 inside
-      auto speed_w = [&](const FreeVector& y) {
-        return std::max(std::fabs(y[1]), std::fabs(y[1] + y[3] / S)) - options.rest_velocity;
-      };
-      include(frame.at(y0));
-      double r_prev = recombination_w(y0), c_prev = recontact_w(y0), v_prev = speed_w(y0);
-      double vm_prev = y0[1], vL_prev = frame.at(y0).dtheta_L;
-      // Recontact is armed once the gap is strictly inside.  A gap that leaves the face with
-      // Δ'' inward and Δ''' outward turns back after about 3|Δ''/Δ'''|: the first step is
-      // kept below that so its samples see the excursion.
-      bool armed = c_prev < 0;
-      double first_step = 0;
-      if (y0[3] == 0 && offset == 0) {
-        const auto [second, third] = free_system.gap_departure(y0);
-        if (face * second < 0 && face * third > 0) first_step = 0.5 * std::fabs(second / third);
-      }
-      std::optional<double> event_tau;
-      bool opposite = false;
-      FreeVector y_event = y0, y_end = y0, y_rest = y0;
-      double rest_tau = 0;
-      march(free_system, y0, remaining, dt_max, oo.tolerance, [&](double ta, double tb, auto& stepper) {
-        auto at_tau = [&](double tau) {
-          FreeVector z;
-          stepper.calc_state(tau, z);
-          return z;
-        };
-        auto samples_upto = [&](double upto) {
-          recorder.record(t0, upto, [&](double tau) { return frame.at(at_tau(tau)); });
-        };
-        double s_prev = ta;
-        const int n = samples_in(ta, tb);
-        for (int k = 1; k <= n; ++k) {
-          const double s = sample_time(ta, tb, k, n);
-          const FreeVector y = at_tau(s);
-          const double r = recombination_w(y), c = recontact_w(y), v = speed_w(y);
-          std::optional<double> t_opposite, t_back;
-          if (r_prev > 0 && r <= 0)
-            t_opposite = refine_root([&](double tau) { return recombination_w(at_tau(tau)); }, s_prev, s, r_prev, r);
-          // Recontact: the gap back on the face.  Unarmed and already outside means a return
-          // the samples missed (or a gap leaving outward): the bodies meet again there.
-          if (c >= 0 && (armed ? c_prev < 0 : c > 0))
-            t_back = refine_root([&](double tau) { return recontact_w(at_tau(tau)); }, s_prev, s,
-                                 std::min(c_prev, 0.0), c);
-          if (t_opposite || t_back) {
-            opposite = t_opposite && (!t_back || *t_opposite <= *t_back);
-            event_tau = opposite ? *t_opposite : *t_back;
-            y_event = at_tau(*event_tau);
-          }
-          const double until = event_tau ? *event_tau : s;
-          const HybridState h_until = frame.at(event_tau ? y_event : y);
-          if (auto z = velocity_zero(s_prev, until, vm_prev, h_until.dtheta_m, [&](double tau) { return at_tau(tau)[1]; }))
-            include(frame.at(at_tau(*z)));
-          if (auto z = velocity_zero(s_prev, until, vL_prev, h_until.dtheta_L,
-                                     [&](double tau) { return frame.at(at_tau(tau)).dtheta_L; }))
-            include(frame.at(at_tau(*z)));
-          if (event_tau) {
-            samples_upto(t0 + *event_tau + 1e-12);
-            return true;
-          }
-          if (!armed && c < 0) armed = true;
-          // Rest bookkeeping: the last time a velocity fell below rest_velocity.
-          if (v_prev >= 0 && v < 0) {
-            rest_tau = refine_root([&](double tau) { return speed_w(at_tau(tau)); }, s_prev, s, v_prev, v);
-            y_rest = at_tau(rest_tau);
-          }
-          r_prev = r;
-          c_prev = c;
-          v_prev = v;
-          vm_prev = h_until.dtheta_m;
-          vL_prev = h_until.dtheta_L;
-          s_prev = s;
-        }
-        const bool last = tb >= remaining;
-        samples_upto(t0 + tb + (last ? 1e-12 : 0.0));
-        if (last) y_end = at_tau(remaining);
-        return false;
-      }, first_step);
-      include(frame.at(event_tau ? y_event : y_end));
-
-      if (!event_tau) {
-        const HybridState end = frame.at(y_end);
-        if (speed_w(y_end) < 0) {
-          const double t_end = t + remaining;
-          t += rest_tau;
-          state = frame.at(y_rest);
-          push_event(EventKind::Rest, false);
-          t = t_end;
-          state = end;
-          return finish(SimulationStatus::Rest);
-        }
-        state = end;
-        t = options.t_end;
-        return finish(SimulationStatus::Completed);
-      }
-      t += *event_tau;
-      // Inelastic impact (eq. 24) on the face hit.
-      const HybridState before = frame.at(y_event);
-      const int face_hit = opposite ? -face : face;
-      const double omega = (p.Jm * before.dtheta_m + p.JL * before.dtheta_L) / (p.Jm + p.JL);
-      const double theta_o = measured(p, before);
-      state = contact_on_face(p, face_hit, theta_o, omega);
-      const double tc = contact_torque(p, theta_o, omega);
-      const bool holds = -face_hit * tc >= -1e-14 * std::max(1.0, std::fabs(tc));
-      if (!holds) state.in_contact = false;  // a bounce: the bodies part again at once
-      push_event(opposite ? EventKind::Recombination : EventKind::Recontact, !holds);
-      impacts.push_back(t);
-      while (!impacts.empty() && impacts.front() < t - options.zeno_window) impacts.pop_front();
-      if (static_cast<int>(impacts.size()) >= options.zeno_impacts)
-        return stop(SimulationStatus::Chattering, std::to_string(options.zeno_impacts) + " impacts within " +
-                                                      std::to_string(options.zeno_window) + " s (Zeno)");
-    }
-  } catch (const NonFiniteState&) {
-    return stop(SimulationStatus::NonFinite, "the integration produced a non-finite state");
-  } catch (const odeint::step_adjustment_error&) {
-    return stop(SimulationStatus::NonFinite, "odeint could not adjust its step");
-  } catch (const odeint::no_progress_error&) {
-    return stop(SimulationStatus::NonFinite, "odeint made no progress");
   }
-  return finish(SimulationStatus::Completed);
+  // Extremes inside a step: the zeros of a velocity between two samples, located on the interpolant.
+  template <class VelocityAt>
+  std::optional<double> velocity_zero(double a, double b, double va, double vb, VelocityAt velocity_at) const {
+    if (!o_.track_extremes || !((va < 0 && vb >= 0) || (va > 0 && vb <= 0))) return std::nullopt;
+    return refine_root(velocity_at, a, b, va, vb);
+  }
+  int samples_in(double ta, double tb) const {
+    return std::max(1, static_cast<int>(std::ceil((tb - ta) / spacing_ * (1 - 1e-12))));
+  }
+
+  std::optional<SimulationStatus> contact();
+  std::optional<SimulationStatus> flight();
+  std::optional<SimulationStatus> impact(const HybridState& before, int face_hit, bool opposite);
+  SimulationStatus flight_to_end(const FreeFrame& frame, const FreeWitnesses& w, double rest_tau, const FreeVector& y_rest,
+                                 const FreeVector& y_end, double remaining);
+  template <class AtTau>
+  bool contact_sample(const ContactWitness& w, ContactScan& scan, double s_prev, double s, AtTau at_tau,
+                      ContactVector& y_end);
+  template <class AtTau>
+  bool free_sample(const FreeWitnesses& w, const FreeFrame& frame, FreeScan& scan, double s_prev, double s, AtTau at_tau,
+                   FreeVector& y_event, FreeVector& y_rest);
+
+  const Parameters& p_;
+  const SimulationOptions& o_;
+  const OdeintSimulationOptions& oo_;
+  SimulationResult result_;
+  TrajectoryRecorder recorder_;
+  const ContactSystem contact_system_;
+  const double dt_max_, spacing_;
+  const bool at_motor_, rigid_;
+  HybridState state_;
+  double t_ = 0;
+  long separations_ = 0;
+  std::deque<double> impacts_;
+};
+
+// ---- contact on face σ: integrate (θo − θR, θ̇o); separation at the first zero of h = −σ·Tc.
+std::optional<SimulationStatus> OdeintRun::contact() {
+  const Parameters& p = p_;
+  const double remaining = o_.t_end - t_;
+  const double t0 = t_;
+  const int face = state_.face;
+  const ContactVector y0{measured(p, state_) - p.theta_R, state_.dtheta_m};
+  const ContactWitness w{p, face};
+  include(w.at(y0));
+  ContactScan scan{w.hold(y0), y0[1], !rigid_, rigid_, std::nullopt};
+  // Starting on the separation line (Tc ≈ 0): Tc leaving toward its non-holding sign
+  // separates at once; otherwise the witness is armed once it has the holding sign.
+  if (!rigid_ && std::fabs(scan.h_prev) <= 1e-13 * std::max(1.0, std::fabs(y0[1]))) {
+    if (-face * contact_torque_rate(p, y0[0], y0[1]) < 0) scan.separation = 0.0;
+    scan.armed = false;
+  }
+  ContactVector y_end = y0;
+  if (!scan.separation) {
+    march(contact_system_, y0, remaining, dt_max_, oo_.tolerance, [&](double ta, double tb, auto& stepper) {
+      auto at_tau = [&](double tau) {
+        ContactVector z;
+        stepper.calc_state(tau, z);
+        return z;
+      };
+      auto samples_upto = [&](double upto) {
+        recorder_.record(t0, upto, [&](double tau) { return w.at(at_tau(tau)); });
+      };
+      double s_prev = ta;
+      const int n = samples_in(ta, tb);
+      for (int k = 1; k <= n; ++k) {
+        const double s = sample_time(ta, tb, k, n);
+        if (contact_sample(w, scan, s_prev, s, at_tau, y_end)) {
+          samples_upto(t0 + *scan.separation + 1e-12);
+          return true;
+        }
+        s_prev = s;
+      }
+      const bool last = tb >= remaining;
+      samples_upto(t0 + tb + (last ? 1e-12 : 0.0));
+      if (last) y_end = at_tau(remaining);
+      return false;
+    });
+  }
+  const std::optional<double> separation = scan.separation;
+  auto at_vec = [&w](const ContactVector& y) { return w.at(y); };
+  include(at_vec(y_end));
+  if (!separation) {
+    state_ = at_vec(y_end);
+    t_ = o_.t_end;
+    return SimulationStatus::Completed;
+  }
+  if (*separation == 0) recorder_.record(t0, t0 + 1e-12, [&](double) { return at_vec(y0); });
+  t_ += *separation;
+  state_ = at_vec(y_end);
+  state_.in_contact = false;  // face σ is now the face just left
+  push_event(EventKind::Separation, false);
+  if (o_.stop_after_separations > 0 && ++separations_ >= o_.stop_after_separations) return SimulationStatus::Completed;
+  return std::nullopt;
+}
+
+// One witness sample of a contact segment at s (after s_prev): the separation, the first zero
+// of −σ·Tc (true, scan.separation and y_end set) unless the motion there is at rounding level
+// (then contact holds to t_end), else the extremes bookkept and the witness armed.
+template <class AtTau>
+bool OdeintRun::contact_sample(const ContactWitness& w, ContactScan& scan, double s_prev, double s, AtTau at_tau,
+                               ContactVector& y_end) {
+  const ContactVector y = at_tau(s);
+  const double h = w.hold(y);
+  std::optional<double> sep;
+  if (scan.armed && scan.h_prev > 0 && h <= 0) {
+    sep = refine_root([&](double tau) { return w.hold(at_tau(tau)); }, s_prev, s, scan.h_prev, h);
+    if (at_rounding_level(p_, at_tau(*sep))) {  // not a separation: contact holds to t_end
+      sep.reset();
+      scan.armed = false;
+      scan.converged = true;
+    }
+  }
+  const double until = sep ? *sep : s;
+  const ContactVector y_until = sep ? at_tau(*sep) : y;
+  if (auto z = velocity_zero(s_prev, until, scan.v_prev, y_until[1], [&](double tau) { return at_tau(tau)[1]; }))
+    include(w.at(at_tau(*z)));
+  if (sep) {
+    scan.separation = sep;
+    y_end = y_until;
+    return true;
+  }
+  if (!scan.armed && !scan.converged && h > 0) scan.armed = true;
+  scan.h_prev = h;
+  scan.v_prev = y[1];
+  return false;
+}
+
+// ---- free flight from the face σ left: integrate (θm − θm0, θ̇m, S·Δ, S·Δ̇).
+std::optional<SimulationStatus> OdeintRun::flight() {
+  const Parameters& p = p_;
+  const double remaining = o_.t_end - t_;
+  const double t0 = t_;
+  const int face = state_.face;
+  const double half = p.backlash / 2, S = oo_.gap_scale;
+  const FreeSystem free_system{p, measured(p, state_) - p.theta_R, S, at_motor_};
+  const FreeFrame frame{state_.theta_m, state_.theta_L, S, face};
+  const FreeVector y0{0, state_.dtheta_m, 0, S * (state_.dtheta_L - state_.dtheta_m)};
+  // Where the gap starts relative to the face σ b/2 (0 when on it, up to rounding).
+  const double x0 = state_.theta_L - state_.theta_m;
+  const double offset = std::fabs(face * x0 - half) <= 1e-12 * std::max(1.0, p.backlash) ? 0.0 : face * x0 - half;
+  const FreeWitnesses w{face, S, offset, p.backlash, o_.rest_velocity};
+  include(frame.at(y0));
+  FreeScan scan{w.recombination(y0), w.recontact(y0), w.speed(y0), y0[1], frame.at(y0).dtheta_L, false, std::nullopt, false, 0};
+  // Recontact is armed once the gap is strictly inside.  A gap that leaves the face with
+  // Δ'' inward and Δ''' outward turns back after about 3|Δ''/Δ'''|: the first step is
+  // kept below that so its samples see the excursion.
+  scan.armed = scan.c_prev < 0;
+  double first_step = 0;
+  if (y0[3] == 0 && offset == 0) {
+    const auto [second, third] = free_system.gap_departure(y0);
+    if (face * second < 0 && face * third > 0) first_step = 0.5 * std::fabs(second / third);
+  }
+  FreeVector y_event = y0, y_end = y0, y_rest = y0;
+  march(free_system, y0, remaining, dt_max_, oo_.tolerance, [&](double ta, double tb, auto& stepper) {
+    auto at_tau = [&](double tau) {
+      FreeVector z;
+      stepper.calc_state(tau, z);
+      return z;
+    };
+    auto samples_upto = [&](double upto) {
+      recorder_.record(t0, upto, [&](double tau) { return frame.at(at_tau(tau)); });
+    };
+    double s_prev = ta;
+    const int n = samples_in(ta, tb);
+    for (int k = 1; k <= n; ++k) {
+      const double s = sample_time(ta, tb, k, n);
+      if (free_sample(w, frame, scan, s_prev, s, at_tau, y_event, y_rest)) {
+        samples_upto(t0 + *scan.event_tau + 1e-12);
+        return true;
+      }
+      s_prev = s;
+    }
+    const bool last = tb >= remaining;
+    samples_upto(t0 + tb + (last ? 1e-12 : 0.0));
+    if (last) y_end = at_tau(remaining);
+    return false;
+  }, first_step);
+  include(frame.at(scan.event_tau ? y_event : y_end));
+  if (!scan.event_tau) return flight_to_end(frame, w, scan.rest_tau, y_rest, y_end, remaining);
+  t_ += *scan.event_tau;
+  return impact(frame.at(y_event), scan.opposite ? -face : face, scan.opposite);
+}
+
+// A free flight without a gap event to t_end: at rest (the event at the last time a velocity fell
+// below rest_velocity) when every velocity is below it at the end, else still moving.
+SimulationStatus OdeintRun::flight_to_end(const FreeFrame& frame, const FreeWitnesses& w, double rest_tau,
+                                          const FreeVector& y_rest, const FreeVector& y_end, double remaining) {
+  const HybridState end = frame.at(y_end);
+  if (w.speed(y_end) < 0) {
+    const double t_end = t_ + remaining;
+    t_ += rest_tau;
+    state_ = frame.at(y_rest);
+    push_event(EventKind::Rest, false);
+    t_ = t_end;
+    state_ = end;
+    return SimulationStatus::Rest;
+  }
+  state_ = end;
+  t_ = o_.t_end;
+  return SimulationStatus::Completed;
+}
+
+// One witness sample of a free flight at s (after s_prev): the first face reached between them
+// (true, scan.event_tau and y_event set), else the extremes and rest bookkeeping moved on.
+template <class AtTau>
+bool OdeintRun::free_sample(const FreeWitnesses& w, const FreeFrame& frame, FreeScan& scan, double s_prev, double s,
+                            AtTau at_tau, FreeVector& y_event, FreeVector& y_rest) {
+  const FreeVector y = at_tau(s);
+  const double r = w.recombination(y), c = w.recontact(y), v = w.speed(y);
+  std::optional<double> t_opposite, t_back;
+  if (scan.r_prev > 0 && r <= 0)
+    t_opposite = refine_root([&](double tau) { return w.recombination(at_tau(tau)); }, s_prev, s, scan.r_prev, r);
+  // Recontact: the gap back on the face.  Unarmed and already outside means a return
+  // the samples missed (or a gap leaving outward): the bodies meet again there.
+  if (c >= 0 && (scan.armed ? scan.c_prev < 0 : c > 0))
+    t_back = refine_root([&](double tau) { return w.recontact(at_tau(tau)); }, s_prev, s, std::min(scan.c_prev, 0.0), c);
+  if (t_opposite || t_back) {
+    scan.opposite = t_opposite && (!t_back || *t_opposite <= *t_back);
+    scan.event_tau = scan.opposite ? *t_opposite : *t_back;
+    y_event = at_tau(*scan.event_tau);
+  }
+  const double until = scan.event_tau ? *scan.event_tau : s;
+  const HybridState h_until = frame.at(scan.event_tau ? y_event : y);
+  if (auto z = velocity_zero(s_prev, until, scan.vm_prev, h_until.dtheta_m, [&](double tau) { return at_tau(tau)[1]; }))
+    include(frame.at(at_tau(*z)));
+  if (auto z = velocity_zero(s_prev, until, scan.vL_prev, h_until.dtheta_L,
+                             [&](double tau) { return frame.at(at_tau(tau)).dtheta_L; }))
+    include(frame.at(at_tau(*z)));
+  if (scan.event_tau) return true;
+  if (!scan.armed && c < 0) scan.armed = true;
+  // Rest bookkeeping: the last time a velocity fell below rest_velocity.
+  if (scan.v_prev >= 0 && v < 0) {
+    scan.rest_tau = refine_root([&](double tau) { return w.speed(at_tau(tau)); }, s_prev, s, scan.v_prev, v);
+    y_rest = at_tau(scan.rest_tau);
+  }
+  scan.r_prev = r;
+  scan.c_prev = c;
+  scan.v_prev = v;
+  scan.vm_prev = h_until.dtheta_m;
+  scan.vL_prev = h_until.dtheta_L;
+  return false;
+}
+
+// Inelastic impact (eq. 24) on the face hit; a bounce when the torque does not hold there.
+std::optional<SimulationStatus> OdeintRun::impact(const HybridState& before, int face_hit, bool opposite) {
+  const double omega = (p_.Jm * before.dtheta_m + p_.JL * before.dtheta_L) / (p_.Jm + p_.JL);
+  const double theta_o = measured(p_, before);
+  state_ = contact_on_face(p_, face_hit, theta_o, omega);
+  const double tc = contact_torque(p_, theta_o, omega);
+  const bool holds = -face_hit * tc >= -1e-14 * std::max(1.0, std::fabs(tc));
+  if (!holds) state_.in_contact = false;  // a bounce: the bodies part again at once
+  push_event(opposite ? EventKind::Recombination : EventKind::Recontact, !holds);
+  impacts_.push_back(t_);
+  const double window = zeno_window(p_, o_);
+  while (!impacts_.empty() && impacts_.front() < t_ - window) impacts_.pop_front();
+  if (static_cast<int>(impacts_.size()) >= o_.zeno_impacts) {
+    result_.stop_reason = zeno_reason(o_, window);
+    return SimulationStatus::Chattering;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+SimulationResult simulate_with_odeint(const Parameters& p, const HybridState& start, const SimulationOptions& options,
+                                      const OdeintSimulationOptions& oo) {
+  return OdeintRun(p, start, options, oo).run();
 }
 
 SimulationResult simulate_step_with_odeint(const Parameters& p, double step, const SimulationOptions& options,

@@ -47,6 +47,8 @@ double recombined_velocity(const Parameters& p, double dtheta_m, double dtheta_L
   return (p.Jm * dtheta_m + p.JL * dtheta_L) / (p.Jm + p.JL);
 }
 
+double servo_time_unit(const Parameters& p) { return std::sqrt((p.Jm + p.JL) / p.K); }
+
 double slowest_time_scale(const Parameters& p) {
   const double J = p.Jm + p.JL, F = p.Fm + p.FL;
   double scale = 0;

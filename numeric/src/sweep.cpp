@@ -11,6 +11,8 @@
 #include <exception>
 #include <map>
 #include <mutex>
+#include <optional>
+#include <ostream>
 #include <thread>
 
 namespace backlash::numeric {
@@ -68,6 +70,29 @@ std::vector<SweepPoint> figure32_points(int n) {
   return points;
 }
 
+const char* to_string(SweepStatus status) {
+  switch (status) {
+    case SweepStatus::LimitCycle: return "limit_cycle";
+    case SweepStatus::None: return "none";
+    case SweepStatus::Divergent: return "divergent";
+    case SweepStatus::Unvalidated: return "unvalidated";
+    case SweepStatus::Refused: return "refused";
+    case SweepStatus::Error: return "error";
+  }
+  return "error";
+}
+
+std::ostream& operator<<(std::ostream& out, SweepStatus status) { return out << to_string(status); }
+
+SweepStatus sweep_status(CycleStatus status) {
+  switch (status) {
+    case CycleStatus::LimitCycle: return SweepStatus::LimitCycle;
+    case CycleStatus::None: return SweepStatus::None;
+    case CycleStatus::Divergent: return SweepStatus::Divergent;
+  }
+  return SweepStatus::Error;
+}
+
 void shift_angles(LimitCycle& cycle, double offset) {
   if (offset == 0) return;
   cycle.theta_o_max += offset;
@@ -98,14 +123,14 @@ SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& fam
   q.theta_R = 0;
   try {
     if (const std::optional<std::string> problem = parameter_scale_problem(q)) {
-      row.status = "refused";
+      row.status = SweepStatus::Refused;
       row.reason = *problem;
       c.guess = 0, c.warm.reset();
       return row;
     }
     const ValidatedParametricFamily::Verdict verdict = family.judge(q);
     if (!verdict.evaluator) {
-      row.status = "unvalidated";
+      row.status = SweepStatus::Unvalidated;
       row.reason = verdict.reason;
       c.guess = 0, c.warm.reset();
       return row;
@@ -115,7 +140,7 @@ SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& fam
     if (point.effects.any()) {
       const EffectValidationResult gate = validate_effects(*verdict.evaluator, point.effects);
       if (!gate.passed()) {
-        row.status = "unvalidated";
+        row.status = SweepStatus::Unvalidated;
         std::string failing;
         for (const ModeValidation& m : gate.report().modes)
           if (!m.passed) failing += (failing.empty() ? "" : "; ") + m.mode.describe();
@@ -126,69 +151,114 @@ SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& fam
       EffectLimitCycleOptions lc;
       lc.warm_start = c.warm;
       row.cycle = find_limit_cycle(gate.model(), lc);
-      if (row.cycle.status == "limit_cycle") c.warm = row.cycle.section_state; else c.warm.reset();
+      if (row.cycle.status == CycleStatus::LimitCycle) c.warm = row.cycle.section_state; else c.warm.reset();
     } else {
       LimitCycleOptions lc;
       lc.guess = c.guess;
       row.cycle = find_limit_cycle(*verdict.evaluator, lc);
-      c.guess = row.cycle.status == "limit_cycle" ? row.cycle.separation_velocity : 0;
+      c.guess = row.cycle.status == CycleStatus::LimitCycle ? row.cycle.separation_velocity : 0;
     }
     shift_angles(row.cycle, reference);
-    row.status = row.cycle.status;
+    row.status = sweep_status(row.cycle.status);
     row.reason = row.cycle.reason;
   } catch (const std::exception& e) {
-    row.status = "error";
+    row.status = SweepStatus::Error;
     row.reason = e.what();
     c.guess = 0, c.warm.reset();
   }
   return row;
 }
 
+// The family: validated at `validation_samples` evenly spaced points (deterministic: before any
+// worker starts); points whose parameters double precision cannot handle are left out.
+void validate_family(ValidatedParametricFamily& family, long count, const std::function<SweepPoint(long)>& point,
+                     int validation_samples) {
+  std::vector<Parameters> samples;
+  const long k_count = std::min<long>(count, std::max(2, validation_samples));
+  for (long k = 0; k < k_count; ++k) {
+    const long index = k_count == 1 ? 0 : static_cast<long>(static_cast<long double>(k) * (count - 1) / (k_count - 1));
+    Parameters q = point(index).parameters;
+    q.theta_R = 0;
+    if (!parameter_scale_problem(q)) samples.push_back(q);
+  }
+  family.validate_samples(samples);
+}
+
+// The blocks between the workers and the delivering thread: a worker takes the next block while
+// it is fewer than `window` blocks ahead of delivery (memory stays bounded), hands its rows back,
+// and the rows are delivered in block order.  A failure (a worker's exception) stops everything.
+class BlockQueue {
+ public:
+  BlockQueue(long blocks, long window) : blocks_(blocks), window_(window) {}
+  /// The next block to compute, or nothing when done or stopping.
+  std::optional<long> take() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    changed_.wait(lock, [&] { return stopping_ || next_block_ >= blocks_ || next_block_ < next_delivery_ + window_; });
+    if (stopping_ || next_block_ >= blocks_) return std::nullopt;
+    return next_block_++;
+  }
+  void put(long block, std::vector<SweepRow> rows) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    finished_.emplace(block, std::move(rows));
+    changed_.notify_all();
+  }
+  void fail(std::exception_ptr failure) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!failure_) failure_ = failure;
+    stopping_ = true;
+    changed_.notify_all();
+  }
+  /// The rows of the next block in order, or nothing after a failure or the last block.
+  std::optional<std::vector<SweepRow>> next() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (next_delivery_ >= blocks_) return std::nullopt;
+    changed_.wait(lock, [&] { return failure_ || finished_.count(next_delivery_) > 0; });
+    if (failure_) return std::nullopt;
+    std::vector<SweepRow> rows = std::move(finished_.at(next_delivery_));
+    finished_.erase(next_delivery_);
+    ++next_delivery_;
+    changed_.notify_all();
+    return rows;
+  }
+  void stop() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopping_ = true;
+    changed_.notify_all();
+  }
+  std::exception_ptr failure() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return failure_;
+  }
+
+ private:
+  const long blocks_, window_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::map<long, std::vector<SweepRow>> finished_;
+  long next_block_ = 0, next_delivery_ = 0;
+  bool stopping_ = false;
+  std::exception_ptr failure_;
+};
+
 }  // namespace
 
 void run_sweep_streamed(long count, const std::function<SweepPoint(long)>& point, const SweepOptions& options,
                         const std::function<void(const SweepRow&)>& row, SweepSummary* summary) {
   if (count <= 0) return;
-  // The family: validated at evenly spaced samples (deterministic: before any worker starts).
   ValidatedParametricFamily family;
-  {
-    std::vector<Parameters> samples;
-    const long k_count = std::min<long>(count, std::max(2, options.validation_samples));
-    for (long k = 0; k < k_count; ++k) {
-      const long index = k_count == 1 ? 0 : static_cast<long>(static_cast<long double>(k) * (count - 1) / (k_count - 1));
-      Parameters q = point(index).parameters;
-      q.theta_R = 0;
-      if (!parameter_scale_problem(q)) samples.push_back(q);
-    }
-    family.validate_samples(samples);
-  }
+  validate_family(family, count, point, options.validation_samples);
   const long block = std::max(1, options.block);
   const long blocks = (count + block - 1) / block;
   const long threads = std::max<long>(1, std::min<long>(options.threads, blocks));
-  const long window = 4 * threads;  // blocks computed ahead of the one being delivered
-
-  std::mutex mutex;
-  std::condition_variable changed;
-  std::map<long, std::vector<SweepRow>> finished;
-  long next_block = 0, next_delivery = 0;
-  bool stopping = false;
-  std::exception_ptr failure;
+  BlockQueue queue(blocks, 4 * threads);  // blocks computed ahead of the one being delivered
   std::atomic<long> done{0};
   std::mutex progress_mutex;
-
   auto work = [&] {
     try {
-      while (true) {
-        long b = 0;
-        {
-          std::unique_lock<std::mutex> lock(mutex);
-          changed.wait(lock, [&] { return stopping || next_block >= blocks || next_block < next_delivery + window; });
-          if (stopping || next_block >= blocks) return;
-          b = next_block++;
-        }
+      while (const std::optional<long> b = queue.take()) {
         std::vector<SweepRow> rows;
         Continuation continuation;
-        for (long i = b * block; i < std::min(count, (b + 1) * block); ++i) {
+        for (long i = *b * block; i < std::min(count, (*b + 1) * block); ++i) {
           rows.push_back(sweep_row(point(i), family, continuation));
           const long finished_points = ++done;
           if (options.progress) {
@@ -196,47 +266,27 @@ void run_sweep_streamed(long count, const std::function<SweepPoint(long)>& point
             options.progress(finished_points, count);
           }
         }
-        std::lock_guard<std::mutex> lock(mutex);
-        finished.emplace(b, std::move(rows));
-        changed.notify_all();
+        queue.put(*b, std::move(rows));
       }
     } catch (...) {
-      std::lock_guard<std::mutex> lock(mutex);
-      if (!failure) failure = std::current_exception();
-      stopping = true;
-      changed.notify_all();
+      queue.fail(std::current_exception());
     }
   };
   std::vector<std::thread> pool;
   for (long k = 0; k < threads; ++k) pool.emplace_back(work);
   auto stop_workers = [&] {
-    {
-      std::lock_guard<std::mutex> lock(mutex);
-      stopping = true;
-      changed.notify_all();
-    }
+    queue.stop();
     for (std::thread& t : pool) t.join();
   };
   try {
-    while (next_delivery < blocks) {
-      std::vector<SweepRow> rows;
-      {
-        std::unique_lock<std::mutex> lock(mutex);
-        changed.wait(lock, [&] { return failure || finished.count(next_delivery) > 0; });
-        if (failure) break;
-        rows = std::move(finished.at(next_delivery));
-        finished.erase(next_delivery);
-        ++next_delivery;
-        changed.notify_all();
-      }
-      for (const SweepRow& r : rows) row(r);
-    }
+    while (const std::optional<std::vector<SweepRow>> rows = queue.next())
+      for (const SweepRow& r : *rows) row(r);
   } catch (...) {
     stop_workers();
     throw;
   }
   stop_workers();
-  if (failure) std::rethrow_exception(failure);
+  if (const std::exception_ptr failure = queue.failure()) std::rethrow_exception(failure);
   if (summary) {
     summary->validated_samples = family.samples_validated();
     summary->failed_samples = family.samples_failed();

@@ -160,28 +160,18 @@ std::optional<ValidatedEvaluator> in_error_coordinates(const ValidatedEvaluator&
   return ValidatedEvaluator(std::move(shifted), evaluator.report());
 }
 
-ValidationResult validate(EvaluatorPtr evaluator, const ValidationOptions& o) {
-  ValidationResult result;
-  ValidationReport& r = result.report_;
-  if (!evaluator) throw std::invalid_argument("validate: no evaluator");
-  const Parameters& p = evaluator->parameters();
-  r.evaluator = evaluator->name();
-  r.kind = evaluator->kind();
-  r.branches = evaluator->branches();
-  r.tolerance = o.tolerance;
+namespace {
 
-  const char* free_names[] = {"theta_m", "dtheta_m", "theta_L", "dtheta_L", "gap"};
-  std::vector<Tracker> free(5);
-  for (int i = 0; i < 5; ++i) free[i].e.state = free_names[i];
-
-  // Everything is compared in error coordinates, θ − θR: the reference integrates the segment
-  // with θR = 0 (the dynamics do not depend on θR), the evaluator's angles are shifted by θR.
-  // A reference integrated at θR = 1e4 would carry odeint's relative tolerance times 1e4.
+// The free mode against odeint over the θ̇m0 grid, in error coordinates θ − θR: the reference
+// integrates the segment with θR = 0 (the dynamics do not depend on θR), the evaluator's angles
+// are shifted by θR.  A reference integrated at θR = 1e4 would carry odeint's relative
+// tolerance times 1e4.
+void compare_free_mode(const SegmentEvaluator& evaluator, const ValidationOptions& o, ValidationReport& r,
+                       std::vector<Tracker>& free) {
+  const Parameters& p = evaluator.parameters();
   const double R = p.theta_R;
   Parameters centred = p;
   centred.theta_R = 0;
-
-  // Free mode over the θ̇m0 grid.
   r.free_horizon = free_horizon(p, o);
   const std::vector<double> free_times = time_grid(r.free_horizon, o.time_points);
   for (double v0 : o.dtheta_m0_grid) {
@@ -204,7 +194,7 @@ ValidationResult validate(EvaluatorPtr evaluator, const ValidationOptions& o) {
     const double scales[] = {position_scale, motor_speed, position_scale, load_speed, position_scale};
     for (std::size_t i = 0; i < n; ++i) {
       const double t = times[i];
-      const FreeState s = evaluator->free_state(t, v0);
+      const FreeState s = evaluator.free_state(t, v0);
       const FreeState& ref = reference[i];
       const double errors[] = {std::fabs((s.theta_m - R) - ref.theta_m), std::fabs(s.dtheta_m - ref.dtheta_m),
                                std::fabs((s.theta_L - R) - ref.theta_L), std::fabs(s.dtheta_L - ref.dtheta_L),
@@ -212,17 +202,22 @@ ValidationResult validate(EvaluatorPtr evaluator, const ValidationOptions& o) {
       for (int k = 0; k < 5; ++k) free[k].see(errors[k], scales[k], t, v0, 0, 0);
     }
   }
+}
 
-  // Contact mode.
+// The contact mode against odeint from the options' starts (by default: at rest on either side
+// of θR, near it, moving, and on the separation line), in error coordinates as the free mode.
+void compare_contact_mode(const SegmentEvaluator& evaluator, const ValidationOptions& o, ValidationReport& r,
+                          Tracker (&contact)[2]) {
+  const Parameters& p = evaluator.parameters();
+  const double R = p.theta_R;
+  Parameters centred = p;
+  centred.theta_R = 0;
   std::vector<std::pair<double, double>> starts = o.contact_starts;
   if (starts.empty()) {
     const double cot = cot_phi(p);
     starts = {{R - 1, 0}, {R + 1, 0}, {R - 1e-3, 0}, {R + 0.5, -0.3}};
     for (double v : {-1.0, 0.1, 1.0}) starts.push_back({R + cot * v, v});
   }
-  Tracker contact[2];
-  contact[0].e.state = "theta_o";
-  contact[1].e.state = "dtheta_o";
   r.contact_horizon = contact_horizon(p, o);
   const std::vector<double> contact_times = time_grid(r.contact_horizon, o.time_points);
   for (const auto& [x0, xd0] : starts) {
@@ -235,12 +230,33 @@ ValidationResult validate(EvaluatorPtr evaluator, const ValidationOptions& o) {
       speed = std::max(speed, std::fabs(c.dtheta_o));
     }
     for (std::size_t i = 0; i < contact_times.size(); ++i) {
-      const ContactState s = evaluator->contact_state(contact_times[i], x0, xd0);
+      const ContactState s = evaluator.contact_state(contact_times[i], x0, xd0);
       contact[0].see(std::fabs((s.theta_o - R) - reference[i].theta_o), position_scale, contact_times[i], 0, x0, xd0);
       contact[1].see(std::fabs(s.dtheta_o - reference[i].dtheta_o), speed, contact_times[i], 0, x0, xd0);
     }
   }
+}
 
+}  // namespace
+
+ValidationResult validate(EvaluatorPtr evaluator, const ValidationOptions& o) {
+  ValidationResult result;
+  ValidationReport& r = result.report_;
+  if (!evaluator) throw std::invalid_argument("validate: no evaluator");
+  const Parameters& p = evaluator->parameters();
+  r.evaluator = evaluator->name();
+  r.kind = evaluator->kind();
+  r.branches = evaluator->branches();
+  r.tolerance = o.tolerance;
+
+  const char* free_names[] = {"theta_m", "dtheta_m", "theta_L", "dtheta_L", "gap"};
+  std::vector<Tracker> free(5);
+  for (int i = 0; i < 5; ++i) free[i].e.state = free_names[i];
+  compare_free_mode(*evaluator, o, r, free);
+  Tracker contact[2];
+  contact[0].e.state = "theta_o";
+  contact[1].e.state = "dtheta_o";
+  compare_contact_mode(*evaluator, o, r, contact);
   Tracker cot;
   cot.e.state = "cot_phi";
   cot.see(std::fabs(evaluator->cot_phi() - cot_phi(p)), std::fabs(cot_phi(p)), 0, 0, 0, 0);

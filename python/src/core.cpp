@@ -316,7 +316,7 @@ void bind_sweep(py::module_& m) {
   using Row = numeric::SweepRow;
   auto sweep_value = [](double numeric::LimitCycle::*field) {
     return [field](const api::Sweep& s) {
-      return column(s.rows, [field](const Row& r) { return api::status_of(r) == "limit_cycle" ? r.cycle.*field : NAN; });
+      return column(s.rows, [field](const Row& r) { return r.status == numeric::SweepStatus::LimitCycle ? r.cycle.*field : NAN; });
     };
   };
   py::class_<api::Sweep>(m, "Sweep")

@@ -299,7 +299,7 @@ doc::Document case_document(const CaseResult& c, const ThesisData& data) {
 
   out.push_back(doc::heading(3, doc::text("The limit cycle")));
   const Erratum* magnitude_erratum = find_erratum(data.errata, "Section14", c.spec.id, "magnitude (peak-to-peak of theta_o)");
-  if (c.cycle.status == "limit_cycle") {
+  if (c.cycle.status == numeric::CycleStatus::LimitCycle) {
     const numeric::LimitCycle& lc = c.cycle;
     std::vector<std::vector<Rich>> rows{
         {doc::text("magnitude: peak-to-peak of θo (section 14)"), doc::text(fixed(lc.peak_to_peak, 9)), doc::text(tc.limit_cycle_printed),
@@ -383,7 +383,7 @@ doc::Document case_document(const CaseResult& c, const ThesisData& data) {
                                 doc::text("load peak-to-peak 2A − b"), doc::text("motor peak-to-peak 2A"), doc::text("")},
                                rows, "rrrrrl"));
     const auto predicted = df.predicted();
-    if (predicted && c.cycle.status == "limit_cycle") {
+    if (predicted && c.cycle.status == numeric::CycleStatus::LimitCycle) {
       const double exact_frequency = 2 * M_PI / c.cycle.period;
       const double ratio = predicted->load_peak_to_peak / c.cycle.peak_to_peak;
       std::vector<std::vector<Rich>> cmp{
@@ -407,7 +407,7 @@ doc::Document case_document(const CaseResult& c, const ThesisData& data) {
     } else if (predicted) {
       out.push_back(doc::paragraph(doc::bold("Verdict:") +
                                    doc::text(" the describing function predicts a cycle that does not exist (" + c.cycle.reason + ").")));
-    } else if (c.cycle.status == "limit_cycle") {
+    } else if (c.cycle.status == numeric::CycleStatus::LimitCycle) {
       out.push_back(doc::paragraph(doc::bold("Verdict:") + doc::text(" the describing function predicts no cycle (" + df.reason +
                                                                      "), but the exact system has one.")));
     } else {

@@ -165,7 +165,7 @@ CaseResult compute_case(const std::string& id, const ThesisData& data) {
   }
 
   c.cycle = numeric::find_limit_cycle(ev);
-  if (c.cycle.status == "limit_cycle") {
+  if (c.cycle.status == numeric::CycleStatus::LimitCycle) {
     const double v = c.cycle.separation_velocity;
     const numeric::HybridState start = numeric::state_on_face(p, -1, p.theta_R + ev.cot_phi() * v, v, false);
     numeric::SimulationOptions o;
@@ -629,7 +629,7 @@ std::vector<Plot> sweep_figures(const std::vector<SweepResult>& sweeps, const st
       }
       Series& s = series[row.point.series];
       s.x.push_back(row.point.x);
-      s.y.push_back(row.status == "limit_cycle" ? row.cycle.peak_to_peak : nan_value);
+      s.y.push_back(row.status == numeric::SweepStatus::LimitCycle ? row.cycle.peak_to_peak : nan_value);
     }
     for (std::size_t k = 0; k < order.size(); ++k) {
       Series s = series[order[k]];

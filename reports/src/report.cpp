@@ -279,8 +279,8 @@ BuiltReport build_report(const DataPaths& paths) {
     for (const numeric::SweepRow& r : s.rows) {
       const numeric::Parameters& q = r.point.parameters;
       csv << symbolic::escape::csv_field(r.point.series) << "," << csv_number(r.point.x) << "," << csv_number(q.Jm) << "," << csv_number(q.Fm)
-          << "," << csv_number(q.JL) << "," << csv_number(q.FL) << "," << symbolic::escape::csv_field(r.status);
-      if (r.status == "limit_cycle")
+          << "," << csv_number(q.JL) << "," << csv_number(q.FL) << "," << symbolic::escape::csv_field(numeric::to_string(r.status));
+      if (r.status == numeric::SweepStatus::LimitCycle)
         csv << "," << csv_number(r.cycle.peak_to_peak) << "," << csv_number(r.cycle.period) << "," << csv_number(r.cycle.multiplier) << "\n";
       else
         csv << ",,,\n";
@@ -315,7 +315,7 @@ BuiltReport build_report(const DataPaths& paths) {
     for (const CaseResult& c : cases) {
       std::size_t errata_count = 0;
       for (const Erratum& e : data.errata) errata_count += e.case_id == c.spec.id ? 1 : 0;
-      const bool cycle = c.cycle.status == "limit_cycle";
+      const bool cycle = c.cycle.status == numeric::CycleStatus::LimitCycle;
       std::string comparison;
       if (cycle && c.thesis->limit_cycle_printed != "none")
         comparison = sig(100 * (printed_number(c.thesis->limit_cycle_printed) / c.cycle.peak_to_peak - 1), 3) + "%";

@@ -485,7 +485,7 @@ TEST(EffectsLimitCycle, TheGeneralReturnMapReproducesEveryNominalCycle) {
     o.general = true;
     o.step = step_of(id);
     const numeric::LimitCycle g = numeric::find_limit_cycle(with_effects(nominal(id), Effects{}), o);
-    ASSERT_EQ(g.status, "limit_cycle") << id << ": " << g.reason;
+    ASSERT_EQ(g.status, numeric::CycleStatus::LimitCycle) << id << ": " << g.reason;
     EXPECT_NEAR(g.peak_to_peak, n.peak_to_peak, 1e-9) << id;
     EXPECT_NEAR(g.amplitude, n.amplitude, 1e-9) << id;
     EXPECT_NEAR(g.period, n.period, 1e-9) << id;
@@ -502,12 +502,12 @@ TEST(EffectsLimitCycle, CoulombFrictionShrinksThenKillsTheCycle) {
   double previous = nominal_size;
   for (double TL : {0.005, 0.01, 0.015}) {
     const numeric::LimitCycle c = numeric::find_limit_cycle(with_effects(nominal("V"), coulomb(0, TL)), o);
-    ASSERT_EQ(c.status, "limit_cycle") << "TL = " << TL << ": " << c.reason;
+    ASSERT_EQ(c.status, numeric::CycleStatus::LimitCycle) << "TL = " << TL << ": " << c.reason;
     EXPECT_LT(c.peak_to_peak, previous) << "TL = " << TL;
     previous = c.peak_to_peak;
   }
   const numeric::LimitCycle dead = numeric::find_limit_cycle(with_effects(nominal("V"), coulomb(0, 0.04)), o);
-  EXPECT_EQ(dead.status, "none");
+  EXPECT_EQ(dead.status, numeric::CycleStatus::None);
   EXPECT_NE(dead.reason.find("rest"), std::string::npos) << dead.reason;
 }
 
@@ -523,7 +523,7 @@ TEST(EffectsLimitCycle, EachCycleIsWhereTheStepResponseEndsUp) {
     numeric::EffectLimitCycleOptions o;
     o.step = step_of("V");
     const numeric::LimitCycle c = numeric::find_limit_cycle(model, o);
-    ASSERT_EQ(c.status, "limit_cycle") << e.describe() << ": " << c.reason;
+    ASSERT_EQ(c.status, numeric::CycleStatus::LimitCycle) << e.describe() << ": " << c.reason;
     SimulationOptions so;
     so.t_end = 400;
     so.track_extremes = true;

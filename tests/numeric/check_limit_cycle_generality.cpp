@@ -37,14 +37,14 @@ TEST(SweepFigures31And32, ThesisCasesAreSweepPoints) {
   const double case_V = find_limit_cycle(validated(load_measured(0.5, 0.1, 0.5, 0.3))).peak_to_peak;
   EXPECT_NEAR(rows31[1].cycle.peak_to_peak, case_VI, 1e-9) << "fig. 31 at FL/F = .25 returned " << rows31[1].cycle.peak_to_peak;
   EXPECT_NEAR(rows31[3].cycle.peak_to_peak, case_V, 1e-9);
-  for (const SweepRow& r : rows31) EXPECT_EQ(r.status, "limit_cycle") << r.point.series << " x=" << r.point.x;
+  for (const SweepRow& r : rows31) EXPECT_EQ(r.status, SweepStatus::LimitCycle) << r.point.series << " x=" << r.point.x;
 }
 
 TEST(SweepFigure31, MagnitudeIsContinuousAcrossTheEqualRatesBranch) {
   // FL/F = .5 with JL = Jm is Fm/Jm = FL/JL (cot φ = 0): the cycle must sit between its neighbours.
   const auto rows = run_sweep(figure31_points(21), SweepOptions{});
   for (size_t i = 1; i + 1 < 21; ++i) {
-    ASSERT_EQ(rows[i].status, "limit_cycle") << "x = " << rows[i].point.x;
+    ASSERT_EQ(rows[i].status, SweepStatus::LimitCycle) << "x = " << rows[i].point.x;
     const double lo = std::min(rows[i - 1].cycle.peak_to_peak, rows[i + 1].cycle.peak_to_peak);
     const double hi = std::max(rows[i - 1].cycle.peak_to_peak, rows[i + 1].cycle.peak_to_peak);
     EXPECT_GE(rows[i].cycle.peak_to_peak, lo - 1e-3) << "x = " << rows[i].point.x;
@@ -57,7 +57,7 @@ TEST(LimitCycleGenerality, ReferenceShiftMovesTheCycleRigidly) {
   const LimitCycle a = find_limit_cycle(validated(p));
   p.theta_R = -2.5;
   const LimitCycle b = find_limit_cycle(validated(p));
-  ASSERT_EQ(b.status, "limit_cycle");
+  ASSERT_EQ(b.status, CycleStatus::LimitCycle);
   EXPECT_NEAR(a.peak_to_peak, b.peak_to_peak, 1e-9);
   EXPECT_NEAR(a.theta_o_max - 1, b.theta_o_max + 2.5, 1e-9);
   EXPECT_NEAR(a.period, b.period, 1e-9);
@@ -70,7 +70,7 @@ TEST(LimitCycleGenerality, EveryLoadMeasuredPoleStructureHasAStableCycle) {
                                    load_measured(0.5, 0.2, 0.5, 0.2)};  // Fm/Jm = FL/JL
   for (const Parameters& p : structures) {
     const LimitCycle c = find_limit_cycle(validated(p));
-    EXPECT_EQ(c.status, "limit_cycle") << "Fm=" << p.Fm << " FL=" << p.FL << ": " << c.reason;
+    EXPECT_EQ(c.status, CycleStatus::LimitCycle) << "Fm=" << p.Fm << " FL=" << p.FL << ": " << c.reason;
     EXPECT_TRUE(c.stable) << "multiplier " << c.multiplier;
   }
 }
@@ -96,7 +96,7 @@ TEST(HybridSimulationGenerality, MotorMeasuredCasesSettle) {
   const SimulationResult r = simulate_step(validated(p), 1.0, o);
   EXPECT_EQ(r.status, SimulationStatus::Rest) << "returned " << to_string(r.status) << " instead of rest";
   EXPECT_NEAR(r.theta_o_final, 1.0, 1e-8);
-  EXPECT_EQ(find_limit_cycle(validated(p)).status, "none");
+  EXPECT_EQ(find_limit_cycle(validated(p)).status, CycleStatus::None);
 }
 
 }  // namespace

@@ -44,7 +44,7 @@ void expect_converges(const std::string& id, double step) {
 
 void expect_cycle(const std::string& id, const char* printed_magnitude, double step_inside, double step_outside) {
   const numeric::LimitCycle& c = cycle(id);
-  ASSERT_EQ(c.status, "limit_cycle") << "case " << id << ": " << c.reason;
+  ASSERT_EQ(c.status, numeric::CycleStatus::LimitCycle) << "case " << id << ": " << c.reason;
   EXPECT_TRUE(c.stable) << "case " << id << ": multiplier " << c.multiplier;
   EXPECT_GT(c.period, 0);
   EXPECT_NEAR(c.peak_to_peak, 2 * c.amplitude, 1e-9) << "the cycle is odd-symmetric about theta_R";
@@ -60,10 +60,10 @@ void expect_cycle(const std::string& id, const char* printed_magnitude, double s
 }
 
 TEST(Section14_CaseI_NoLimitCycle, BacklashOutsideTheLoop) {
-  EXPECT_EQ(cycle("I").status, "none") << cycle("I").reason;
+  EXPECT_EQ(cycle("I").status, numeric::CycleStatus::None) << cycle("I").reason;
   EXPECT_FALSE(cycle("I").reason.empty());
 }
-TEST(Section14_CaseII_NoLimitCycle, BacklashOutsideTheLoop) { EXPECT_EQ(cycle("II").status, "none") << cycle("II").reason; }
+TEST(Section14_CaseII_NoLimitCycle, BacklashOutsideTheLoop) { EXPECT_EQ(cycle("II").status, numeric::CycleStatus::None) << cycle("II").reason; }
 TEST(Section14_CaseIII_LimitCycle, MagnitudeAndConvergence) { expect_cycle("III", "1.030", 1.145, 0.057); }
 TEST(Section14_CaseIV_LimitCycle, MagnitudeAndConvergence) { expect_cycle("IV", "1.150", 0.69, 0.435); }
 TEST(Section14_CaseV_LimitCycle, MagnitudeAndConvergence) { expect_cycle("V", ".52", 0.62, 0.23); }

@@ -152,8 +152,8 @@ TEST(Soak, RandomValidParameterSetsFinishWithAStatusAndTheSimulatorsAgree) {
 
     // Limit cycle: a status, finite numbers for a cycle, a reason otherwise.
     const numeric::LimitCycle cycle = numeric::find_limit_cycle(*evaluator);
-    ++cycles[cycle.status];
-    if (cycle.status == "limit_cycle") {
+    ++cycles[numeric::to_string(cycle.status)];
+    if (cycle.status == numeric::CycleStatus::LimitCycle) {
       EXPECT_TRUE(std::isfinite(cycle.peak_to_peak) && std::isfinite(cycle.period) && cycle.period > 0)
           << label << ": limit cycle with peak-to-peak " << cycle.peak_to_peak << ", period " << cycle.period;
     } else {

@@ -15,6 +15,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -48,7 +49,7 @@ TEST(Item01_Divergence, UndampedLoadServoIsReportedDivergentWithTheComputedReaso
   ASSERT_TRUE(h.valid) << h.outcome;
   EXPECT_GT(h.v_out, 0.62) << "the separation velocity does not grow";
   const numeric::LimitCycle c = numeric::find_limit_cycle(v.evaluator());
-  EXPECT_EQ(c.status, "divergent") << "returned " << c.status << " instead of divergent (reason: " << c.reason << ")";
+  EXPECT_EQ(c.status, numeric::CycleStatus::Divergent) << "returned " << c.status << " instead of divergent (reason: " << c.reason << ")";
   EXPECT_TRUE(contains(c.reason, "grows")) << "returned reason '" << c.reason << "' instead of one saying it grows";
   EXPECT_FALSE(contains(c.reason, "decays")) << "returned reason '" << c.reason << "', which was not computed";
 }
@@ -58,7 +59,7 @@ TEST(Item02_ErrorCoordinates, LargeReferenceGivesCaseVsCycleAndStepResponse) {
   const numeric::ValidationResult base = validated(case_v(0));
   ASSERT_TRUE(base.passed());
   const numeric::LimitCycle c0 = numeric::find_limit_cycle(base.evaluator());
-  ASSERT_EQ(c0.status, "limit_cycle");
+  ASSERT_EQ(c0.status, numeric::CycleStatus::LimitCycle);
   numeric::SimulationOptions o;
   o.t_end = 60;
   const numeric::SimulationResult r0 = numeric::simulate_step(base.evaluator(), 0.62, o);
@@ -66,7 +67,7 @@ TEST(Item02_ErrorCoordinates, LargeReferenceGivesCaseVsCycleAndStepResponse) {
     const numeric::ValidationResult v = validated(case_v(R));
     ASSERT_TRUE(v.passed()) << "theta_R = " << R << ": refused by the gate: " << v.report().failures();
     const numeric::LimitCycle c = numeric::find_limit_cycle(v.evaluator());
-    ASSERT_EQ(c.status, "limit_cycle") << "theta_R = " << R << ": returned " << c.status << " instead of limit_cycle";
+    ASSERT_EQ(c.status, numeric::CycleStatus::LimitCycle) << "theta_R = " << R << ": returned " << c.status << " instead of limit_cycle";
     EXPECT_NEAR(c.peak_to_peak, c0.peak_to_peak, 1e-9) << "theta_R = " << R;
     EXPECT_NEAR(c.period, c0.period, 1e-9) << "theta_R = " << R;
     EXPECT_NEAR(c.theta_o_max - R, c0.theta_o_max, 1e-9) << "theta_R = " << R << ": angles not shifted back";
@@ -93,10 +94,13 @@ TEST(Item03_SweepVerdicts, CaseVItselfIsValidatedInAWideGainSweep) {
   options.threads = 1;
   const std::vector<numeric::SweepRow> rows = numeric::run_sweep(points, options);
   ASSERT_EQ(rows.size(), 3u);
-  EXPECT_EQ(rows[0].status, "limit_cycle") << "K = 1 (case V) returned " << rows[0].status << " instead of limit_cycle ("
+  EXPECT_EQ(rows[0].status, numeric::SweepStatus::LimitCycle) << "K = 1 (case V) returned " << rows[0].status << " instead of limit_cycle ("
                                            << rows[0].reason << ")";
-  for (const numeric::SweepRow& r : rows)
-    if (r.status != "limit_cycle") EXPECT_FALSE(r.reason.empty()) << "K = " << r.point.x << ": " << r.status << " without a reason";
+  for (const numeric::SweepRow& r : rows) {
+    if (r.status != numeric::SweepStatus::LimitCycle) {
+      EXPECT_FALSE(r.reason.empty()) << "K = " << r.point.x << ": " << r.status << " without a reason";
+    }
+  }
 }
 
 // 4. Where double precision cannot resolve the backlash, refuse with the reason.
@@ -224,6 +228,116 @@ TEST(Item07_Scales, ExhaustedSearchIsAStatusNotAnException) {
   numeric::CrossingOptions budget;
   budget.max_intervals = 1000;
   EXPECT_THROW((void)numeric::first_crossing(w, 0, 1e4, budget), numeric::SearchBudgetExhausted);
+}
+
+// Case V on a time scale `s` times shorter: K·s², F·s, J and b unchanged.  The model is
+// homogeneous: every angle is case V's at time t·s, every velocity s times case V's.
+Parameters case_v_faster(double s) {
+  Parameters p = case_v();
+  p.K *= s * s;
+  p.Fm *= s, p.FL *= s;
+  return p;
+}
+
+// 7. A stiff gain is computed, not mistaken for chattering: case V a million times faster
+// (K = 1e12) has case V's events at a millionth of the times.  (Before: the certified searches
+// measured the state (θ, θ̇) in one norm, so their intervals shrank to J/K = 1e-12 s instead of
+// √(J/K) = 1e-6 s, ended at min_interval as false grazings, and the run stopped as chattering
+// under a fixed 1e-6 s Zeno window after minutes of work.)
+TEST(Item07_StiffGain, CaseVAMillionTimesFasterHasCaseVsEventsAtAMillionthOfTheTimes) {
+  const double s = 1e6;
+  const numeric::ValidationResult slow = validated(case_v()), fast = validated(case_v_faster(s));
+  ASSERT_TRUE(fast.passed()) << fast.report().failures();
+  numeric::SimulationOptions o;
+  o.t_end = 60;
+  const numeric::SimulationResult a = numeric::simulate_step(slow.evaluator(), 0.62, o);
+  o.t_end = 60 / s;
+  const numeric::SimulationResult b = numeric::simulate_step(fast.evaluator(), 0.62, o);
+  ASSERT_EQ(b.status, a.status) << "K = 1e12 returned " << numeric::to_string(b.status) << " instead of "
+                                << numeric::to_string(a.status) << ": " << b.stop_reason;
+  ASSERT_EQ(b.events.size(), a.events.size())
+      << "K = 1e12 returned " << b.events.size() << " events instead of case V's " << a.events.size();
+  for (std::size_t i = 0; i < a.events.size(); ++i) {
+    EXPECT_EQ(b.events[i].kind, a.events[i].kind) << "event " << i;
+    EXPECT_NEAR(b.events[i].t * s, a.events[i].t, 1e-7 * a.events[i].t)
+        << "event " << i << " at " << b.events[i].t * s << " time units instead of " << a.events[i].t;
+    EXPECT_NEAR(b.events[i].theta_o, a.events[i].theta_o, 1e-7) << "event " << i;
+  }
+  EXPECT_NEAR(b.theta_o_final, a.theta_o_final, 1e-7);
+}
+
+TEST(Item07_StiffGain, CaseVAMillionTimesFasterHasCaseVsLimitCycle) {
+  const double s = 1e6;
+  const numeric::LimitCycle a = numeric::find_limit_cycle(validated(case_v()).evaluator());
+  const numeric::LimitCycle b = numeric::find_limit_cycle(validated(case_v_faster(s)).evaluator());
+  ASSERT_EQ(b.status, numeric::CycleStatus::LimitCycle) << "K = 1e12 returned " << b.status << ": " << b.reason;
+  EXPECT_NEAR(b.period * s, a.period, 1e-7 * a.period) << "returned " << b.period * s << " time units instead of " << a.period;
+  EXPECT_NEAR(b.separation_velocity / s, a.separation_velocity, 1e-7 * a.separation_velocity);
+  EXPECT_NEAR(b.peak_to_peak, a.peak_to_peak, 1e-7) << "returned " << b.peak_to_peak << " instead of " << a.peak_to_peak;
+  EXPECT_NEAR(b.multiplier, a.multiplier, 1e-4) << "returned " << b.multiplier << " instead of " << a.multiplier;
+}
+
+// The Zeno window is a fraction of the system's fastest time scale, the same fraction for any
+// gain: case V and case V a million times faster have windows a million times apart.
+TEST(Item07_StiffGain, ZenoWindowScalesWithTheSystemsTimeScale) {
+  const numeric::SimulationOptions o;
+  const double slow = numeric::zeno_window(case_v(), o), fast = numeric::zeno_window(case_v_faster(1e6), o);
+  EXPECT_NEAR(slow / fast, 1e6, 1e-6) << "returned windows " << slow << " s and " << fast << " s";
+  EXPECT_NEAR(slow * numeric::fastest_mode_rate(case_v()), numeric::zeno_time_scales, 1e-20);
+  numeric::SimulationOptions fixed;
+  fixed.zeno_window = 0.5;
+  EXPECT_EQ(numeric::zeno_window(case_v(), fixed), 0.5) << "a window given in seconds is kept";
+}
+
+// 8. Events go to a sink as they happen: a long run keeps no event list.
+TEST(Item08_Streaming, EventsAreStreamedNotStored) {
+  const numeric::ValidationResult v = validated(case_v());
+  numeric::SimulationOptions o;
+  o.t_end = 2000;
+  const numeric::SimulationResult kept = numeric::simulate_step(v.evaluator(), 0.62, o);
+  std::vector<numeric::SimulationEvent> seen;
+  o.event_sink = [&](const numeric::SimulationEvent& e) { seen.push_back(e); };
+  const numeric::SimulationResult sunk = numeric::simulate_step(v.evaluator(), 0.62, o);
+  EXPECT_EQ(sunk.events.size(), 0u) << "returned " << sunk.events.size() << " stored events instead of 0";
+  ASSERT_EQ(seen.size(), kept.events.size()) << "returned " << seen.size() << " events instead of " << kept.events.size();
+  ASSERT_GT(seen.size(), 300u);
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    EXPECT_EQ(seen[i].t, kept.events[i].t) << "event " << i;
+    EXPECT_EQ(seen[i].theta_o, kept.events[i].theta_o) << "event " << i << " (angles shifted back by θR)";
+  }
+  EXPECT_EQ(sunk.status, kept.status);
+  EXPECT_EQ(sunk.theta_o_final, kept.theta_o_final);
+  o.max_events = 40;  // the cap counts sunk events too
+  EXPECT_EQ(numeric::simulate_step(v.evaluator(), 0.62, o).status, SimulationStatus::EventLimit);
+}
+
+// A sweep of 10^9 points makes its points on demand, by index: stopped after 100 rows, it has
+// made the family's validation samples and a few blocks ahead, never a list of the points.
+TEST(Item08_Streaming, BillionPointSweepMakesItsPointsOnDemand) {
+  const long n = 500'000'000;  // 2n = 10^9 points of figure 31
+  std::atomic<long> made{0};
+  auto point = [&](long i) {
+    ++made;
+    return numeric::figure31_point(n, i);
+  };
+  numeric::SweepOptions options;
+  options.threads = 2;
+  long rows = 0;
+  struct Enough {};
+  try {
+    numeric::run_sweep_streamed(2 * n, point, options, [&](const numeric::SweepRow& r) {
+      // FL/F = 2e-9 and up: a load time scale of 6e8 s, refused by the scale check (with its reason)
+      const bool answered = r.status == numeric::SweepStatus::LimitCycle ||
+                            (r.status == numeric::SweepStatus::Refused && !r.reason.empty());
+      EXPECT_TRUE(answered) << "x = " << r.point.x << " returned " << r.status << ": " << r.reason;
+      if (++rows == 100) throw Enough{};
+    });
+  } catch (const Enough&) {
+  }
+  EXPECT_EQ(rows, 100);
+  // validation samples + at most (window 4·threads + threads in flight + 1) blocks of 32
+  const long bound = options.validation_samples + (5 * options.threads + 1) * options.block + 100;
+  EXPECT_LE(made.load(), bound) << "returned " << made.load() << " points made instead of at most " << bound;
 }
 
 // 8. Samples go to a sink as they are computed: memory does not grow with the output.

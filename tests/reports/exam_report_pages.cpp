@@ -348,7 +348,7 @@ TEST(DescribingFunction, CaseVPredictionBesideTheExactCycle) {
 
   // The exact cycle: the ledger's value (section 14) and the pinned number.
   const numeric::LimitCycle cycle = numeric::find_limit_cycle(v.evaluator());
-  ASSERT_EQ(cycle.status, "limit_cycle");
+  ASSERT_EQ(cycle.status, numeric::CycleStatus::LimitCycle);
   const auto errata = reports::load_errata(BACKLASH_ERRATA_DIR);
   const reports::Erratum* e = reports::find_erratum(errata, "Section14", "V", "magnitude (peak-to-peak of theta_o)");
   ASSERT_NE(e, nullptr);

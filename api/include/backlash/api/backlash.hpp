@@ -219,7 +219,7 @@ struct Cycle {
   /// "limit_cycle", "none" (reason in cycle.reason) or "divergent": the CLI's `status`.
   /// The one place the numeric layer's status is turned into text.
   std::string status() const;
-  bool found() const { return status() == "limit_cycle"; }
+  bool found() const { return cycle.status == numeric::CycleStatus::LimitCycle; }
   std::string json() const;  ///< `limit-cycle CASE --json`
   std::string text() const;  ///< `limit-cycle CASE`
 };

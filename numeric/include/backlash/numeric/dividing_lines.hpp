@@ -45,7 +45,7 @@ struct DividingLines {
 };
 
 struct TraceOptions {
-  double horizon = 0;  ///< 0 → 40 of the slowest time scales (at least 60)
+  double horizon = 0;  ///< 0 → 40 of the slowest time scales (segment_dynamics.hpp)
 };
 
 /// One point (any sign of θ̇m0; θ̇m0 = 0 gives NoRecombination).

@@ -36,7 +36,7 @@ struct EffectLimitCycleOptions {
   std::vector<double> seed_velocities{0.05, 0.2, 0.6, 1.5};  ///< further seeds (× max(1, |θR|))
   int max_cycles = 300;         ///< full cycles iterated per seed
   double tolerance = 1e-13;     ///< convergence of the iteration (relative to the section state)
-  double horizon = 0;           ///< time allowed for one return (0: 60 slowest time scales, ≥ 100 s)
+  double horizon = 0;           ///< time allowed for one return (0: 60 slowest time scales)
   bool general = false;         ///< use this method even without effects (tests)
   std::optional<HybridState> warm_start;  ///< a neighbouring cycle's section state, tried first (sweeps)
 };

@@ -50,6 +50,10 @@ struct LinearWitness {
   /// a stiff segment known as a sum of exponentials Σ c_j e^{λ_j t}: Σ |c_j||λ_j|³ times the
   /// larger of e^{Re λ_j t} at the ends (a decayed fast mode then bounds nothing).
   std::function<double(double, double)> third_derivative_bound;
+  /// The system's time unit (segment_dynamics.hpp, servo_time_unit: √(J/K), 1 s for the thesis's
+  /// cases): the floor of the root's relative tolerance and the unit of min_interval, so that a
+  /// servo a million times faster is resolved as finely in its own time.
+  double time_unit = 1;
 };
 
 struct Crossing {
@@ -59,8 +63,8 @@ struct Crossing {
 };
 
 struct CrossingOptions {
-  double time_tolerance = 1e-14;  ///< toms748 stopping width, relative to t
-  double min_interval = 1e-11;    ///< below this an uncertified interval is a grazing contact
+  double time_tolerance = 1e-14;  ///< toms748 stopping width, relative to max(t, time_unit)
+  double min_interval = 1e-11;    ///< in time units: below this an uncertified interval is a grazing contact
   long max_intervals = 2'000'000; ///< guard: then SearchBudgetExhausted (never a hang)
 };
 

@@ -12,11 +12,12 @@
 // swings of θo, θm and θL (one frame, docs/physics.md), the period and the
 // separation velocity v*, and eq. 38's C at separation and just after
 // recombination.  No fixed point (cases I, II: the backlash is outside the loop)
-// is the status "none", with the reason.
+// is the status none, with the reason.
 #pragma once
 
 #include "backlash/numeric/hybrid_simulation.hpp"
 
+#include <iosfwd>
 #include <optional>
 #include <string>
 #include <vector>
@@ -41,8 +42,15 @@ double stability_constant(const Parameters& p, double theta_o, double dtheta_o);
 /// exp(−π a/ω): the factor by which the principal-branch C jumps across θo = θR.
 double stability_constant_jump(const Parameters& p);
 
+/// What a limit-cycle search found: a cycle, none (the reason says why), or an oscillation that
+/// grows instead of settling (g(v) > v wherever sampled).
+enum class CycleStatus { LimitCycle, None, Divergent };
+/// "limit_cycle", "none", "divergent": the text of the CLI's and the CSV's `status`.
+const char* to_string(CycleStatus status);
+std::ostream& operator<<(std::ostream& out, CycleStatus status);  ///< as to_string (test messages)
+
 struct LimitCycle {
-  std::string status = "none";  ///< "limit_cycle" | "none" | "divergent" (g(v) > v wherever sampled)
+  CycleStatus status = CycleStatus::None;
   std::string reason;           ///< for "none" and "divergent": what the search computed, in words
   double separation_velocity = 0;   ///< v*
   double multiplier = 0;            ///< P'(v*) = g'(v*)² of the full return map

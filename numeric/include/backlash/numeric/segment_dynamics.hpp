@@ -43,4 +43,8 @@ double recombined_velocity(const Parameters& p, double dtheta_m, double dtheta_L
 /// A time scale for horizons: the slowest time constant (or period) of the segments.
 double slowest_time_scale(const Parameters& p);
 
+/// The servo's time unit √(J/K), J = Jm + JL: 1 s for the thesis's cases (J = K = 1).  Rounding
+/// tolerances on times, and velocities compared with angles, are taken in it.
+double servo_time_unit(const Parameters& p);
+
 }  // namespace backlash::numeric

@@ -41,9 +41,19 @@ struct SweepPoint {
   Effects effects;     ///< the effects at this point (effects_limit_cycle.hpp when any)
 };
 
+/// A sweep point's outcome: the limit-cycle search's (CycleStatus), or why it was not searched:
+/// unvalidated (its evaluators failed their gate), refused (double precision cannot handle its
+/// parameters: scales.hpp), error (an exception, its text in the reason).
+enum class SweepStatus { LimitCycle, None, Divergent, Unvalidated, Refused, Error };
+/// "limit_cycle", "none", "divergent", "unvalidated", "refused", "error": the CSV's `status`.
+const char* to_string(SweepStatus status);
+std::ostream& operator<<(std::ostream& out, SweepStatus status);  ///< as to_string (test messages)
+/// The row status of a point whose search ran.
+SweepStatus sweep_status(CycleStatus status);
+
 struct SweepRow {
   SweepPoint point;
-  std::string status;  ///< "limit_cycle" | "none" | "divergent" | "unvalidated" | "refused" | "error"
+  SweepStatus status = SweepStatus::Error;
   std::string reason;  ///< for every status but "limit_cycle": why, in words
   std::string branches;
   LimitCycle cycle;
