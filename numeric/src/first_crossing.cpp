@@ -114,6 +114,22 @@ struct Witness {
 
 bool same_sign(double x, double y) { return (x > 0 && y > 0) || (x < 0 && y < 0); }
 
+// Whether w''(0) is resolved from the error of the start's time.  The flight starts at an event
+// located to a tolerance δt (CrossingOptions::time_tolerance relative to the time unit, times
+// the segment's length in units): a start shifted by δt along the motion has w''(0) moved by
+// w'''·δt.  On the separation line w''(0) = 0 exactly, and what is computed there is that shift,
+// of order 0.1 rad/s² for K = 1e12 (w''' ~ 1e19 rad/s³, δt ~ 1e-20 s).  Taken as the leading
+// term it certifies a departure of only ~|w''/w'''| (5e-21 s), and the search from there finds
+// the spurious zero of w''t²/2 + w'''t³/6 at −3w''/w''' as a return to the face just left: a
+// flight of no length (docs/physics.md, leaving a face).  A bounce's w''(0) (the torque after
+// the impact) is a genuine leading term however small, as long as it exceeds that shift.
+constexpr double kStartTimeUncertainty = 1e-12;  // in time units: 100 × time_tolerance
+
+bool quadratic_resolved(double second, double third, double time_unit) {
+  if (!std::isfinite(third)) return true;
+  return std::fabs(second) > std::fabs(third) * kStartTimeUncertainty * time_unit;
+}
+
 }  // namespace
 
 std::optional<double> certified_departure(const LinearWitness& witness, double noise) {
@@ -125,7 +141,7 @@ std::optional<double> certified_departure(const LinearWitness& witness, double n
   const double scale = std::max(std::fabs(second), 1e-300);
   const double growth = std::max(0.0, W.mu_A);  // ‖D x'(t)‖∞ ≤ e^{μ∞(DAD⁻¹) t} z0
   // w'' dominant: |w''(0)| > t0 sup|w'''|, sup|w'''| ≤ ‖eA²‖ e^{μ t0} z0.
-  if (std::fabs(second) > 1e-12 * std::max(1.0, z0)) {
+  if (std::fabs(second) > 1e-12 * std::max(1.0, z0) && quadratic_resolved(second, third, witness.time_unit)) {
     double t0 = std::sqrt(2 * noise / scale);
     for (int attempt = 0; attempt < 60; ++attempt, t0 *= 0.5)
       if (std::fabs(second) > t0 * W.norm_eA2 * std::exp(growth * t0) * z0) return t0;

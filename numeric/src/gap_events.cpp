@@ -26,9 +26,9 @@ std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::
   // Return to the face left: Δx starts as O(t²) or O(t³), below rounding noise at first.
   w.level = 0;
   std::optional<Crossing> back;
-  if (const std::optional<double> t0 = certified_departure(w, 1e-10 * std::max(1.0, position_scale)))
-    back = first_crossing(w, *t0, opposite ? opposite->t : horizon);
-  if (back && (!opposite || back->t < opposite->t)) return GapEvent{GapEventKind::FaceLeft, *back};
+  const std::optional<double> t0 = certified_departure(w, 1e-10 * std::max(1.0, position_scale));
+  if (t0) back = first_crossing(w, *t0, opposite ? opposite->t : horizon);
+  if (back && (!opposite || back->t < opposite->t)) return GapEvent{GapEventKind::FaceLeft, *back, *t0};
   if (opposite) return GapEvent{GapEventKind::OppositeFace, *opposite};
   return std::nullopt;
 }

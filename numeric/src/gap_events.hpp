@@ -15,6 +15,7 @@ enum class GapEventKind { OppositeFace, FaceLeft };
 struct GapEvent {
   GapEventKind kind;
   Crossing crossing;
+  double departure = 0;  ///< FaceLeft: the certified departure t0, w ≠ 0 on (0, t0], the search's start
 };
 
 /// The witness of the gap change Δx = θL − θm − Δx(0) − level of a free flight.

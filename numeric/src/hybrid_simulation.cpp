@@ -294,6 +294,7 @@ class ClosedFormRun {
   std::optional<SimulationStatus> flight();
   SimulationStatus rest(const Flight& flight, double remaining, const HybridState& end);
   std::optional<SimulationStatus> impact(const detail::GapEvent& event, const HybridState& before);
+  std::optional<std::string> unresolved_return(const detail::GapEvent& event) const;
 
   const ValidatedEvaluator& evaluator_;
   const Parameters& p_;
@@ -424,10 +425,30 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
     t_ = o_.t_end;
     return SimulationStatus::Completed;
   }
+  if (auto problem = unresolved_return(*event)) {
+    result_.stop_reason = std::move(*problem);
+    return SimulationStatus::Unresolved;
+  }
   recorder_.record(t_, t_ + event->crossing.t + 1e-12, flight.at);
   const HybridState before = flight.at(event->crossing.t);
   t_ += event->crossing.t;
   return impact(*event, before);
+}
+
+// A return to the face just left, found within the search's resolution of the certified
+// departure t0 (w ≠ 0 on (0, t0]): the exact flight departs as t² or t³ and cannot return there,
+// so the search has not resolved the gap from rounding (a flight of no length, which would
+// start a burst of events at one instant).  Said, never continued (docs/physics.md, leaving a face).
+std::optional<std::string> ClosedFormRun::unresolved_return(const detail::GapEvent& event) const {
+  if (event.kind != detail::GapEventKind::FaceLeft) return std::nullopt;
+  const double resolution = CrossingOptions{}.min_interval * servo_time_unit(p_);
+  if (event.crossing.t > event.departure + resolution) return std::nullopt;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "the free flight from t = %.17g s returned to the face it left after %.3g s, within the "
+                "search's resolution %.3g s of its certified departure: the gap is not resolved from rounding",
+                t_, event.crossing.t, resolution);
+  return std::string(text);
 }
 
 // Rest: the event at the last time any velocity exceeded the tolerance (bisection on the

@@ -289,6 +289,48 @@ TEST(Item07_StiffGain, ZenoWindowScalesWithTheSystemsTimeScale) {
   EXPECT_EQ(numeric::zeno_window(case_v(), fixed), 0.5) << "a window given in seconds is kept";
 }
 
+// 7. A stiff gain alone (K = 1e12, case V's frictions: ζ ≈ 2e-7, the separation velocity grows
+// every half cycle) is computed right or stopped with the reason, never completed with wrong
+// events.  Its exact equivalent by time scaling is the 10⁶ times slower system K = 1, F/10⁶,
+// times ×10⁶.  (Before: at a separation near 1e7 rad/s w''(0) of the gap, zero on the separation
+// line, came out as 0.19 rad/s² from the rounding of the state; taken as the leading term it
+// certified a departure of 5e-21 s, the search found a return to the face just left there, and
+// the run went on with a recontact and a separation at the same instant, status completed.)
+TEST(Item07_StiffGain, StiffGainAloneIsRightAgainstItsSlowEquivalentOrStopsUnresolved) {
+  const double s = 1e6, units = 2000;  // 1278 events; the first wrong one was the 282nd
+  Parameters fast = case_v(), slow = case_v();
+  fast.K = s * s;
+  slow.Fm /= s, slow.FL /= s;
+  const numeric::ValidationResult vf = validated(fast), vs = validated(slow);
+  ASSERT_TRUE(vf.passed()) << vf.report().failures();
+  ASSERT_TRUE(vs.passed()) << vs.report().failures();
+  numeric::SimulationOptions o;
+  o.t_end = units;
+  const numeric::SimulationResult a = numeric::simulate_step(vs.evaluator(), 0.62, o);
+  o.t_end = units / s;
+  const numeric::SimulationResult b = numeric::simulate_step(vf.evaluator(), 0.62, o);
+  ASSERT_EQ(a.status, SimulationStatus::Completed) << a.stop_reason;
+  ASSERT_GT(a.events.size(), 1000u);
+  if (b.status == SimulationStatus::Unresolved) {
+    EXPECT_TRUE(contains(b.stop_reason, "not resolved")) << "returned reason '" << b.stop_reason << "'";
+  } else {
+    ASSERT_EQ(b.status, a.status) << "K = 1e12 returned " << numeric::to_string(b.status) << " instead of "
+                                  << numeric::to_string(a.status) << ": " << b.stop_reason;
+    ASSERT_EQ(b.events.size(), a.events.size())
+        << "K = 1e12 returned " << b.events.size() << " events instead of the slow system's " << a.events.size();
+    EXPECT_NEAR(b.theta_o_final, a.theta_o_final, 1e-7);
+  }
+  ASSERT_LE(b.events.size(), a.events.size()) << "K = 1e12 returned " << b.events.size() << " events instead of " << a.events.size();
+  for (std::size_t i = 0; i < b.events.size(); ++i) {  // the events up to a stop are right too
+    ASSERT_EQ(b.events[i].kind, a.events[i].kind)
+        << "event " << i << " is a " << numeric::to_string(b.events[i].kind) << " instead of a "
+        << numeric::to_string(a.events[i].kind);
+    ASSERT_NEAR(b.events[i].t * s, a.events[i].t, 1e-9 * a.events[i].t)
+        << "event " << i << " at " << b.events[i].t * s << " time units instead of " << a.events[i].t;
+    ASSERT_NEAR(b.events[i].theta_o, a.events[i].theta_o, 1e-7) << "event " << i;
+  }
+}
+
 // 8. Events go to a sink as they happen: a long run keeps no event list.
 TEST(Item08_Streaming, EventsAreStreamedNotStored) {
   const numeric::ValidationResult v = validated(case_v());

@@ -80,7 +80,9 @@ class SearchBudgetExhausted : public std::runtime_error {
 /// with w''(0) ≠ 0 after a bounce, or w''(0) = 0 and w'''(0) ≠ 0 on the
 /// separation line): a time t0 > 0 such that w is certified non-zero on
 /// (0, t0] (its first non-vanishing derivative keeps its sign there) and
-/// |w(t0)| ≈ noise; nothing when both vanish.
+/// |w(t0)| ≈ noise; nothing when both vanish.  A w''(0) no larger than w'''(0)
+/// times 1e-12 time units is the error of the start's event time, not a leading
+/// term (docs/physics.md, leaving a face).
 std::optional<double> certified_departure(const LinearWitness& witness, double noise);
 
 /// First t in (t_begin, t_end] with w(t) = 0, or nothing.
