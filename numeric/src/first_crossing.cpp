@@ -1,5 +1,7 @@
 #include "backlash/numeric/first_crossing.hpp"
 
+#include "balancing.hpp"
+
 #include <boost/math/tools/roots.hpp>
 
 #include <cmath>
@@ -41,30 +43,6 @@ double log_norm(const SmallMatrix& A) {
 // and event time, stays exactly the unscaled one.
 constexpr double kBalanceGain = 16;
 
-SmallVector balancing(const SmallMatrix& A) {
-  const Eigen::Index n = A.rows();
-  SmallVector d = SmallVector::Ones(n);
-  for (int sweep = 0; sweep < 64; ++sweep) {
-    bool changed = false;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      double c = 0, r = 0;  // off-diagonal column and row sums of D A D⁻¹
-      for (Eigen::Index j = 0; j < n; ++j) {
-        if (j == i) continue;
-        c += std::fabs(A(j, i)) * d(j) / d(i);
-        r += std::fabs(A(i, j)) * d(i) / d(j);
-      }
-      if (c == 0 || r == 0) continue;
-      const double f = std::exp2(std::round(0.5 * std::log2(c / r)));  // d_i·f balances row and column i
-      if (f != 1 && c / f + r * f < 0.95 * (c + r)) {
-        d(i) *= f;
-        changed = true;
-      }
-    }
-    if (!changed) break;
-  }
-  return d;
-}
-
 struct Witness {
   const LinearWitness& lw;
   SmallRow eA, eA2, eA3;
@@ -80,7 +58,7 @@ struct Witness {
     mu_A = log_norm(w.A);
     scale = SmallVector::Ones(w.A.rows());
     if (mu_A > 0) {
-      const SmallVector d = balancing(w.A);
+      const SmallVector d = detail::balancing(w.A);
       const SmallMatrix balanced = d.asDiagonal() * w.A * d.cwiseInverse().asDiagonal();
       const double mu_balanced = log_norm(balanced);
       if (mu_balanced * kBalanceGain < mu_A) {

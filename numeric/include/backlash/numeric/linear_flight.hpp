@@ -2,7 +2,7 @@
 // initial state, in closed form: x(t) = e^{A t} x0 + ∫₀ᵗ e^{A s} ds c, from the
 // exponential of the augmented matrix [[A, c], [0, 0]] (Eigen's
 // MatrixFunctions: Padé approximation with scaling and squaring, accurate to a
-// few ulps).  Used for free flight that does not start on the separation line
+// few ulps; a stiff matrix is balanced first, e^M = D⁻¹ e^{DMD⁻¹} D).  Used for free flight that does not start on the separation line
 // (after a bounce), where the per-case evaluators (t, θ̇m0) do not apply; its
 // agreement with Boost.Odeint is tested like every evaluator's.
 #pragma once
