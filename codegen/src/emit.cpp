@@ -99,6 +99,16 @@ class CaseEmitter {
   std::vector<State> states_;
 
   const State& state(const std::string& name) const;
+
+  // the header's parts, in its order
+  using Parameters = std::vector<std::pair<std::string, ex>>;
+  void preamble(std::ostream& h, const CaseSource& source, const Parameters& parameters) const;
+  void metadata(std::ostream& h, const CaseSource& source, const Parameters& parameters);
+  void constants(std::ostream& h, const Parameters& parameters);
+  void state_functions(std::ostream& h);
+  void combined_state(std::ostream& h, const char* type, const char* function, const std::vector<const char*>& fields,
+                      const std::vector<Input>& inputs);
+  void combined_states(std::ostream& h);
 };
 
 CaseEmitter::CaseEmitter(const symbolic::CaseDerivation& d) : d_(d), terms_(d.radicals) {
@@ -137,34 +147,49 @@ std::map<std::string, std::string> CaseEmitter::latex() {
 
 std::string CaseEmitter::header(const model::CaseSpec& spec) {
   const CaseSource source = describe_source(spec);
-  const std::string ns = case_namespace(d_.case_id);
-  const std::string contact_branch = symbolic::contact_branch_name(d_.contact_branch);
-  const std::string free_branch = symbolic::free_branch_name(d_.free_branch);
   const symbolic::CaseParameters& p = d_.parameters;
-  const std::vector<std::pair<std::string, ex>> parameters{{"Jm", p.Jm}, {"Fm", p.Fm}, {"JL", p.JL},
-                                                           {"FL", p.FL}, {"K", p.K},   {"theta_R", p.theta_R},
-                                                           {"backlash", p.backlash}};
-
+  const Parameters parameters{{"Jm", p.Jm}, {"Fm", p.Fm}, {"JL", p.JL}, {"FL", p.FL}, {"K", p.K}, {"theta_R", p.theta_R}, {"backlash", p.backlash}};
   std::ostringstream h;
+  preamble(h, source, parameters);
+  metadata(h, source, parameters);
+  constants(h, parameters);
+  state_functions(h);
+  combined_states(h);
+  h << "/// LaTeX of every generated expression (exact).\n";
+  h << "struct latex {\n";
+  for (const auto& [name, tex] : latex())
+    h << "  static constexpr const char* " << name << " = R\"tex(" << tex << ")tex\";\n";
+  h << "};\n\n";
+  h << emit_forced_namespace(d_);  // namespace forced: the modes with a constant forcing (emit_forced.hpp)
+  h << "}  // namespace backlash::generated::" << case_namespace(d_.case_id) << "\n";
+  return h.str();
+}
+
+// The banner, what the case is (output, branches, exact parameters, initial states) and the namespace opened.
+void CaseEmitter::preamble(std::ostream& h, const CaseSource& source, const Parameters& parameters) const {
+  const symbolic::CaseParameters& p = d_.parameters;
   h << banner(source.display_path, source.input_hash);
   h << "//\n// " << symbolic::escape::cpp_comment(d_.name) << ": output measured at the " << measured_text(p.measured_at) << "; contact branch "
-    << contact_branch << ", free branch " << free_branch << ".\n";
+    << symbolic::contact_branch_name(d_.contact_branch) << ", free branch " << symbolic::free_branch_name(d_.free_branch) << ".\n";
   h << "// Exact parameters:";
   for (const auto& [name, value] : parameters) h << " " << name << " = " << print(value, Style::Text) << ";";
   h << "\n// Free mode starts on the separation line: theta_m(0) = theta_L(0) = theta_R + cot_phi*dtheta_m0,\n"
        "// theta_m'(0) = theta_L'(0) = dtheta_m0.  Contact mode starts at (theta_o0, dtheta_o0).\n"
        "// Every function is the exact closed form with its constants rounded once.\n";
-  h << "#pragma once\n\n#include <cmath>\n\nnamespace backlash::generated::" << ns << " {\n\n";
+  h << "#pragma once\n\n#include <cmath>\n\nnamespace backlash::generated::" << case_namespace(d_.case_id) << " {\n\n";
+}
 
+// struct metadata: the case, its source and hash, the generator, the branches and the parameters (names, exact, rounded).
+void CaseEmitter::metadata(std::ostream& h, const CaseSource& source, const Parameters& parameters) {
   h << "struct metadata {\n";
   h << "  static constexpr const char* case_id = " << quoted(d_.case_id) << ";\n";
   h << "  static constexpr const char* case_name = " << quoted(d_.name) << ";\n";
   h << "  static constexpr const char* source_file = " << quoted(source.display_path) << ";\n";
   h << "  static constexpr const char* input_hash = " << quoted(source.input_hash) << ";\n";
   h << "  static constexpr const char* generator = " << quoted(generator_name()) << ";\n";
-  h << "  static constexpr const char* measured_at = " << quoted(measured_text(p.measured_at)) << ";\n";
-  h << "  static constexpr const char* contact_branch = " << quoted(contact_branch) << ";\n";
-  h << "  static constexpr const char* free_branch = " << quoted(free_branch) << ";\n";
+  h << "  static constexpr const char* measured_at = " << quoted(measured_text(d_.parameters.measured_at)) << ";\n";
+  h << "  static constexpr const char* contact_branch = " << quoted(symbolic::contact_branch_name(d_.contact_branch)) << ";\n";
+  h << "  static constexpr const char* free_branch = " << quoted(symbolic::free_branch_name(d_.free_branch)) << ";\n";
   h << "  static constexpr int parameter_count = " << parameters.size() << ";\n";
   h << "  static constexpr const char* parameter_order[" << parameters.size() << "] = {";
   for (std::size_t i = 0; i < parameters.size(); ++i) h << (i ? ", " : "") << quoted(parameters[i].first);
@@ -175,7 +200,10 @@ std::string CaseEmitter::header(const model::CaseSpec& spec) {
   h << "  static constexpr double parameters[" << parameters.size() << "] = {";
   for (std::size_t i = 0; i < parameters.size(); ++i) h << (i ? ", " : "") << terms_.literal_of(parameters[i].second);
   h << "};\n};\n\n";
+}
 
+// The rounded constants: parameters, the separation line, the frequencies and the exponentials' rates.
+void CaseEmitter::constants(std::ostream& h, const Parameters& parameters) {
   h << "// Parameters (exact rationals, rounded once).\n";
   for (const auto& [name, value] : parameters) h << "inline constexpr double " << name << " = " << terms_.literal_of(value) << ";\n";
   h << "\n// Separation line theta_o = theta_R + cot_phi*dtheta_o, cot_phi = (Jm*FL - Fm*JL)/(K*JL) = "
@@ -185,17 +213,18 @@ std::string CaseEmitter::header(const model::CaseSpec& spec) {
 
   h << terms_.frequency_constants();
   const std::vector<Rate>& rates = terms_.rates();
-  if (!rates.empty()) {
-    std::vector<std::size_t> order(rates.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return rates[a].value > rates[b].value; });
-    h << "// Exponentials:";
-    for (std::size_t k = 0; k < order.size(); ++k)
-      h << (k ? ";" : "") << " " << rates[order[k]].name << " = exp(" << print(rates[order[k]].value_exact, Style::Text)
-        << "*t)";
-    h << ".\n\n";
-  }
+  if (rates.empty()) return;
+  std::vector<std::size_t> order(rates.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return rates[a].value > rates[b].value; });
+  h << "// Exponentials:";
+  for (std::size_t k = 0; k < order.size(); ++k)
+    h << (k ? ";" : "") << " " << rates[order[k]].name << " = exp(" << print(rates[order[k]].value_exact, Style::Text) << "*t)";
+  h << ".\n\n";
+}
 
+// One inline function per state, its exact closed form in the comment.
+void CaseEmitter::state_functions(std::ostream& h) {
   for (const State& s : states_) {
     const std::vector<Input>& inputs = s.contact ? contact_inputs_ : free_inputs_;
     h << "/// " << s.meaning << ":\n/// " << s.name << " = " << terms_.exact_text(s.terms, inputs, Style::Text) << "\n";
@@ -203,40 +232,28 @@ std::string CaseEmitter::header(const model::CaseSpec& spec) {
     h << unused_markers({&s.terms}, inputs) << terms_.constants_for({&s.terms});
     h << "  return " << terms_.sum_code(s.terms, inputs, "       ") << ";\n}\n\n";
   }
+}
 
-  const char* free_names[] = {"theta_m", "dtheta_m", "theta_L", "dtheta_L", "gap"};
+// One mode's states at once, sharing each rate's exp: `fields` of struct `type`, returned by `function`.
+void CaseEmitter::combined_state(std::ostream& h, const char* type, const char* function, const std::vector<const char*>& fields,
+                                 const std::vector<Input>& inputs) {
+  std::vector<const std::vector<Term>*> all;
+  for (const char* n : fields) all.push_back(&state(n).terms);
+  h << "inline " << type << " " << function << "(" << parameter_list(inputs) << ") noexcept {\n";
+  h << unused_markers(all, inputs) << terms_.constants_for(all);
+  h << "  " << type << " s;\n";
+  for (const char* n : fields) h << "  s." << n << " = " << terms_.sum_code(state(n).terms, inputs, "      ") << ";\n";
+  h << "  return s;\n}\n\n";
+}
+
+// free_state (theta_m, dtheta_m, theta_L, dtheta_L, gap) and contact_state (theta_o, dtheta_o).
+void CaseEmitter::combined_states(std::ostream& h) {
   h << "struct free_state_t {\n  double theta_m, dtheta_m, theta_L, dtheta_L, gap;\n};\n\n";
   h << "/// All free-mode states at once (one exp per rate).\n";
-  h << "inline free_state_t free_state(" << parameter_list(free_inputs_) << ") noexcept {\n";
-  {
-    std::vector<const std::vector<Term>*> all;
-    for (const char* n : free_names) all.push_back(&state(n).terms);
-    h << unused_markers(all, free_inputs_) << terms_.constants_for(all);
-    h << "  free_state_t s;\n";
-    for (const char* n : free_names)
-      h << "  s." << n << " = " << terms_.sum_code(state(n).terms, free_inputs_, "      ") << ";\n";
-    h << "  return s;\n}\n\n";
-  }
+  combined_state(h, "free_state_t", "free_state", {"theta_m", "dtheta_m", "theta_L", "dtheta_L", "gap"}, free_inputs_);
   h << "struct contact_state_t {\n  double theta_o, dtheta_o;\n};\n\n";
   h << "/// Both contact-mode states at once.\n";
-  h << "inline contact_state_t contact_state(" << parameter_list(contact_inputs_) << ") noexcept {\n";
-  {
-    std::vector<const std::vector<Term>*> all{&state("theta_o").terms, &state("dtheta_o").terms};
-    h << unused_markers(all, contact_inputs_) << terms_.constants_for(all);
-    h << "  contact_state_t s;\n";
-    for (const char* n : {"theta_o", "dtheta_o"})
-      h << "  s." << n << " = " << terms_.sum_code(state(n).terms, contact_inputs_, "      ") << ";\n";
-    h << "  return s;\n}\n\n";
-  }
-
-  h << "/// LaTeX of every generated expression (exact).\n";
-  h << "struct latex {\n";
-  for (const auto& [name, tex] : latex())
-    h << "  static constexpr const char* " << name << " = R\"tex(" << tex << ")tex\";\n";
-  h << "};\n\n";
-  h << emit_forced_namespace(d_);  // namespace forced: the modes with a constant forcing (emit_forced.hpp)
-  h << "}  // namespace backlash::generated::" << ns << "\n";
-  return h.str();
+  combined_state(h, "contact_state_t", "contact_state", {"theta_o", "dtheta_o"}, contact_inputs_);
 }
 
 // ------------------------------------------------------------------ branch emission

@@ -254,24 +254,19 @@ Series other_shaft_during_separation(const numeric::SimulationResult& r, const n
   return s;
 }
 
-Plot phase_plot(const CaseResult& c, const FigureSpec& spec) {
-  const numeric::Parameters& p = c.parameters;
-  const double theta_R = p.theta_R;
-  Plot plot;
-  plot.name = figure_name(spec);
-  plot.title = "Thesis fig. " + std::to_string(spec.number) + ": case " + c.spec.id + ", phase plane θ_{o} vs θ̇_{o}";
-  plot.x_label = "θ_{o}, the " + shaft_name(p, true) + " (rad)";
-  plot.y_label = "θ̇_{o} (rad/s)";
-  plot.width = 1000;
-  plot.height = 940;
-  plot.key = "outside below center horizontal maxcols 2 samplen 2.5 font ',10'";
+// The runs a phase figure shows: the experiment and/or the second inputs, as the figure's data names them.
+std::vector<const TrajectoryRun*> phase_runs(const CaseResult& c, const FigureSpec& spec) {
   std::vector<const TrajectoryRun*> runs;
   for (const std::string& which : spec.trajectories) {
     if (which == "experiment" && !c.runs.empty()) runs.push_back(&c.runs.front());
     if (which == "second")
       for (std::size_t k = 1; k < c.runs.size(); ++k) runs.push_back(&c.runs[k]);
   }
-  // each trajectory up to its sixth separation (enough to show it approach the cycle)
+  return runs;
+}
+
+// Each trajectory up to its sixth separation (enough to show it approach the cycle).
+std::vector<double> cut_at_sixth_separation(const std::vector<const TrajectoryRun*>& runs) {
   std::vector<double> cut;
   for (const TrajectoryRun* r : runs) {
     double t_cut = r->result.t_final;
@@ -283,6 +278,12 @@ Plot phase_plot(const CaseResult& c, const FigureSpec& spec) {
       }
     cut.push_back(t_cut);
   }
+  return cut;
+}
+
+// The phase window: θR, the shown trajectories and the cycle, with a margin of 8 %.
+Window phase_window(const CaseResult& c, const std::vector<const TrajectoryRun*>& runs, const std::vector<double>& cut) {
+  const double theta_R = c.parameters.theta_R;
   Window w{theta_R, theta_R, 0, 0};
   for (std::size_t k = 0; k < runs.size(); ++k)
     for (const numeric::TrajectorySample& s : runs[k]->result.samples)
@@ -293,10 +294,31 @@ Plot phase_plot(const CaseResult& c, const FigureSpec& spec) {
   w.x1 += 0.08 * dx;
   w.y0 -= 0.08 * dy;
   w.y1 += 0.08 * dy;
-  plot.x_range = std::pair{w.x0, w.x1};
-  plot.y_range = std::pair{w.y0, w.y1};
+  return w;
+}
 
-  // isoclines of the combined system through (θR, 0)
+// The label η=… of an isocline whose slope is a round value, at its outer end unless another label is too close.
+void label_isocline(Plot& plot, const Window& w, double theta_R, const symbolic::IsoclineRow& row, double ax, double ay, double bx,
+                    double by) {
+  const double eta = row.is_infinite ? 0 : symbolic::to_double(row.eta, {});
+  const bool labelled = row.is_infinite || row.is_vertical ||
+                        std::fabs(std::fabs(eta) - 1) < 1e-12 || std::fabs(std::fabs(eta) - 2) < 1e-12 ||
+                        std::fabs(std::fabs(eta) - 5) < 1e-12 || std::fabs(eta) < 1e-12 || std::fabs(std::fabs(eta) - 0.5) < 1e-12;
+  if (!labelled) return;
+  const bool upper = by > ay || (by == ay && bx > ax);
+  const double lx = upper ? bx : ax, ly = upper ? by : ay;
+  const std::string text = row.is_infinite ? "η=∞" : "η=" + symbolic::pretty::decimal(eta, 4, symbolic::pretty::Style::Text);
+  // (left-aligned text: kept clear of the right edge of the frame)
+  const double x = std::min(theta_R + 0.9 * (lx - theta_R), w.x1 - 0.06 * (w.x1 - w.x0)), y = 0.9 * ly;
+  bool crowded = false;
+  for (const Label& other : plot.labels)
+    crowded = crowded || (std::fabs(other.x - x) < 0.07 * (w.x1 - w.x0) && std::fabs(other.y - y) < 0.04 * (w.y1 - w.y0));
+  if (!crowded) plot.labels.push_back({text, x, y});
+}
+
+// The isoclines of the combined system through (θR, 0), clipped to the window and labelled.
+void add_isoclines(Plot& plot, const CaseResult& c, const Window& w) {
+  const double theta_R = c.parameters.theta_R;
   Series iso{"isoclines of the combined system (η = θ̈_{o}/θ̇_{o})", {}, {}, "lines lw 1 lc rgb '#c8c8c8'"};
   const symbolic::IsoclineTable& table = c.derivation.isoclines.front();
   for (const symbolic::IsoclineRow& row : table.rows) {
@@ -306,30 +328,19 @@ Plot phase_plot(const CaseResult& c, const FigureSpec& spec) {
     if (!ok) continue;
     iso.x.insert(iso.x.end(), {ax, bx, nan_value});
     iso.y.insert(iso.y.end(), {ay, by, nan_value});
-    const double eta = row.is_infinite ? 0 : symbolic::to_double(row.eta, {});
-    const bool labelled = row.is_infinite || row.is_vertical ||
-                          std::fabs(std::fabs(eta) - 1) < 1e-12 || std::fabs(std::fabs(eta) - 2) < 1e-12 ||
-                          std::fabs(std::fabs(eta) - 5) < 1e-12 || std::fabs(eta) < 1e-12 || std::fabs(std::fabs(eta) - 0.5) < 1e-12;
-    if (labelled) {
-      const bool upper = by > ay || (by == ay && bx > ax);
-      const double lx = upper ? bx : ax, ly = upper ? by : ay;
-      const std::string text = row.is_infinite ? "η=∞" : "η=" + symbolic::pretty::decimal(eta, 4, symbolic::pretty::Style::Text);
-      // (left-aligned text: kept clear of the right edge of the frame)
-      const double x = std::min(theta_R + 0.9 * (lx - theta_R), w.x1 - 0.06 * (w.x1 - w.x0)), y = 0.9 * ly;
-      bool crowded = false;
-      for (const Label& other : plot.labels)
-        crowded = crowded || (std::fabs(other.x - x) < 0.07 * (w.x1 - w.x0) && std::fabs(other.y - y) < 0.04 * (w.y1 - w.y0));
-      if (!crowded) plot.labels.push_back({text, x, y});
-    }
+    label_isocline(plot, w, theta_R, row, ax, ay, bx, by);
   }
   plot.series.push_back(iso);
-  // separation line, one half per face
+}
+
+// The separation line (one half per face) and the recombination loci of both faces: motor, load, recombined (eq. 24).
+void add_separation_and_loci(Plot& plot, const CaseResult& c, const Window& w) {
+  const double theta_R = c.parameters.theta_R;
   const double cot_phi = c.evaluator().cot_phi();
   plot.series.push_back({"separation line, face −b/2 (θ̇_{o} > 0)", {theta_R, theta_R + cot_phi * w.y1}, {0, w.y1},
                          "lines lw 2 dt 2 lc rgb '#000000'"});
   plot.series.push_back({"separation line, face +b/2 (θ̇_{o} < 0)", {theta_R, theta_R + cot_phi * w.y0}, {0, w.y0},
                          "lines lw 2 dt 3 lc rgb '#555555'"});
-  // recombination loci of both faces
   Series motor{"motor before recombination (θ_{m}, θ̇_{m}), both faces", {}, {}, std::string("linespoints lw 1 pt 7 ps 0.35 lc rgb '") + color_motor + "'"};
   Series load{"load before recombination (θ_{L}, θ̇_{L}), both faces", {}, {}, std::string("linespoints lw 1 pt 5 ps 0.35 lc rgb '") + color_load + "'"};
   Series recombined{"after the impact (θ_{o}, θ̇_{o}; eq. 24), both faces", {}, {},
@@ -352,32 +363,54 @@ Plot phase_plot(const CaseResult& c, const FigureSpec& spec) {
   plot.series.push_back(motor);
   plot.series.push_back(load);
   plot.series.push_back(recombined);
-  // trajectories
+}
+
+// The series (θo, θ̇o) of a run's samples.
+Series phase_series(const std::string& title, const std::vector<numeric::TrajectorySample>& samples, const std::string& style) {
+  Series s{title, {}, {}, style};
+  for (const numeric::TrajectorySample& x : samples) {
+    s.x.push_back(x.theta_o);
+    s.y.push_back(x.dtheta_o);
+  }
+  return s;
+}
+
+// The trajectories up to their cut, the other shaft dotted during separation (the thesis's convention).
+void add_trajectories(Plot& plot, const CaseResult& c, const std::vector<const TrajectoryRun*>& runs, const std::vector<double>& cut) {
+  const numeric::Parameters& p = c.parameters;
   for (std::size_t k = 0; k < runs.size(); ++k) {
     const char* color = trajectory_colors[k % 4];
-    Series s{runs[k]->label + ": θ_{o}", {}, {}, std::string("lines lw 1.6 lc rgb '") + color + "'"};
     numeric::SimulationResult shown = runs[k]->result;
     shown.samples.erase(std::remove_if(shown.samples.begin(), shown.samples.end(),
                                        [&](const numeric::TrajectorySample& x) { return x.t > cut[k]; }),
                         shown.samples.end());
-    for (const numeric::TrajectorySample& x : shown.samples) {
-      s.x.push_back(x.theta_o);
-      s.y.push_back(x.dtheta_o);
-    }
-    plot.series.push_back(s);
+    plot.series.push_back(phase_series(runs[k]->label + ": θ_{o}", shown.samples, std::string("lines lw 1.6 lc rgb '") + color + "'"));
     Series other = other_shaft_during_separation(shown, p, runs[k]->label + ": " + shaft_name(p, false) + " during separation",
                                                  std::string("lines lw 1 dt 4 lc rgb '") + color + "'");
     if (series_has_data(other)) plot.series.push_back(other);
   }
-  if (!c.cycle_orbit.empty()) {
-    Series s{"limit cycle (exact)", {}, {}, "lines lw 3.5 lc rgb '#000000'"};
-    for (const numeric::TrajectorySample& x : c.cycle_orbit) {
-      s.x.push_back(x.theta_o);
-      s.y.push_back(x.dtheta_o);
-    }
-    plot.series.push_back(s);
-  }
-  plot.series.push_back({"θ_{R}", {theta_R}, {0}, "points pt 6 ps 1.5 lc rgb '#000000'"});
+}
+
+Plot phase_plot(const CaseResult& c, const FigureSpec& spec) {
+  const numeric::Parameters& p = c.parameters;
+  Plot plot;
+  plot.name = figure_name(spec);
+  plot.title = "Thesis fig. " + std::to_string(spec.number) + ": case " + c.spec.id + ", phase plane θ_{o} vs θ̇_{o}";
+  plot.x_label = "θ_{o}, the " + shaft_name(p, true) + " (rad)";
+  plot.y_label = "θ̇_{o} (rad/s)";
+  plot.width = 1000;
+  plot.height = 940;
+  plot.key = "outside below center horizontal maxcols 2 samplen 2.5 font ',10'";
+  const std::vector<const TrajectoryRun*> runs = phase_runs(c, spec);
+  const std::vector<double> cut = cut_at_sixth_separation(runs);
+  const Window w = phase_window(c, runs, cut);
+  plot.x_range = std::pair{w.x0, w.x1};
+  plot.y_range = std::pair{w.y0, w.y1};
+  add_isoclines(plot, c, w);
+  add_separation_and_loci(plot, c, w);
+  add_trajectories(plot, c, runs, cut);
+  if (!c.cycle_orbit.empty()) plot.series.push_back(phase_series("limit cycle (exact)", c.cycle_orbit, "lines lw 3.5 lc rgb '#000000'"));
+  plot.series.push_back({"θ_{R}", {p.theta_R}, {0}, "points pt 6 ps 1.5 lc rgb '#000000'"});
   return plot;
 }
 

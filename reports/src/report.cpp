@@ -189,6 +189,180 @@ struct PhaseTimer {
       std::cerr << what << ": " << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() << " s\n";
   }
 };
+
+// The LaTeX document being assembled, page after page.
+struct LatexBook {
+  std::ostringstream text;
+  doc::LatexOptions options;
+  LatexBook() {
+    text << latex_preamble();
+    options.top_level = 1;  // page heading 1 → \section
+  }
+  void add(const doc::Document& page) { text << "\\clearpage\n" << doc::to_latex(page, options); }
+};
+
+std::string validation_json(const CaseResult& c) {
+  nlohmann::json v{{"case", c.spec.id}, {"evaluator", c.validation.report().evaluator}, {"passed", c.validation.passed()}};
+  for (const numeric::StateError& s : c.validation.report().states)
+    v["states"].push_back({{"state", s.state}, {"max_abs_error", s.max_abs_error}, {"at_t", s.at_t}, {"passed", s.passed}});
+  return v.dump(2) + "\n";
+}
+
+std::string dividing_lines_csv(const CaseResult& c) {
+  std::ostringstream lines;
+  lines << "v0,status,t,theta_m,dtheta_m,theta_L,dtheta_L,theta_o,dtheta_o\n";
+  for (const numeric::DividingLines* l : {&c.lines_negative, &c.lines_positive})
+    for (const numeric::DividingLinePoint& q : l->points)
+      lines << csv_number(q.dtheta_m0) << "," << numeric::to_string(q.status) << "," << csv_number(q.t) << "," << csv_number(q.theta_m) << ","
+            << csv_number(q.dtheta_m) << "," << csv_number(q.theta_L) << "," << csv_number(q.dtheta_L) << "," << csv_number(q.theta_o)
+            << "," << csv_number(q.dtheta_o) << "\n";
+  return lines.str();
+}
+
+std::string step_response_csv(const TrajectoryRun& run) {
+  std::ostringstream csv;
+  csv << "t,theta_o,dtheta_o,theta_m,dtheta_m,theta_L,dtheta_L,mode\n";
+  for (const numeric::TrajectorySample& s : run.result.samples)
+    csv << csv_number(s.t) << "," << csv_number(s.theta_o) << "," << csv_number(s.dtheta_o) << "," << csv_number(s.theta_m) << ","
+        << csv_number(s.dtheta_m) << "," << csv_number(s.theta_L) << "," << csv_number(s.dtheta_L) << ","
+        << (s.in_contact ? "contact" : "free") << "\n";
+  return csv.str();
+}
+
+// A run's label as a file name: letters, digits, '.' and '-' kept, anything else '_'.
+std::string file_label(std::string name) {
+  for (char& ch : name)
+    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '-') ch = '_';
+  return name;
+}
+
+// One case: its page (Markdown and LaTeX), its figures and its machine-readable outputs.
+void add_case(BuiltReport& report, LatexBook& latex, const CaseResult& c, const ThesisData& data) {
+  const std::string& id = c.spec.id;
+  PhaseTimer case_timer("  case page");
+  const doc::Document page = case_document(c, data);
+  report.files["cases/" + id + ".md"] = markdown(page, "../");
+  report.case_pages[id] = "cases/" + id + ".md";
+  report.case_equations[id] = c.thesis->equations;
+  latex.add(page);
+  for (Plot& plot : case_figures(c, data)) report.figures.push_back(std::move(plot));
+
+  report.files["derivations/" + id + ".json"] = symbolic::to_json(c.derivation).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  report.files["derivations/" + id + ".tex"] = symbolic::to_latex(c.derivation);
+  report.files["validation/" + id + ".json"] = validation_json(c);
+  report.files["dividing_lines/" + id + ".csv"] = dividing_lines_csv(c);
+  for (const TrajectoryRun& run : c.runs) report.files["step_responses/" + id + "_" + file_label(run.label) + ".csv"] = step_response_csv(run);
+}
+
+// The general solutions: their page and the branches' JSON and LaTeX.
+void add_general(BuiltReport& report, LatexBook& latex, const std::vector<symbolic::GeneralBranch>& branches) {
+  PhaseTimer timer("general page");
+  const doc::Document page = general_page(branches);
+  report.files["general.md"] = markdown(page, "");
+  latex.add(page);
+  nlohmann::json all = nlohmann::json::array();
+  std::string tex;
+  for (const symbolic::GeneralBranch& b : branches) {
+    all.push_back(symbolic::to_json(b));
+    tex += symbolic::to_latex(b) + "\n";
+  }
+  report.files["derivations/general.json"] = all.dump(2) + "\n";
+  report.files["derivations/general.tex"] = tex;
+}
+
+std::string sweep_csv(const SweepResult& s) {
+  std::ostringstream csv;
+  csv << "series,x,Jm,Fm,JL,FL,status,peak_to_peak,period,multiplier\n";
+  for (const numeric::SweepRow& r : s.rows) {
+    const numeric::Parameters& q = r.point.parameters;
+    csv << symbolic::escape::csv_field(r.point.series) << "," << csv_number(r.point.x) << "," << csv_number(q.Jm) << "," << csv_number(q.Fm)
+        << "," << csv_number(q.JL) << "," << csv_number(q.FL) << "," << symbolic::escape::csv_field(numeric::to_string(r.status));
+    if (r.status == numeric::SweepStatus::LimitCycle)
+      csv << "," << csv_number(r.cycle.peak_to_peak) << "," << csv_number(r.cycle.period) << "," << csv_number(r.cycle.multiplier) << "\n";
+    else
+      csv << ",,,\n";
+  }
+  return csv.str();
+}
+
+// The errata ledger's own page.
+void add_errata(BuiltReport& report, LatexBook& latex, const ThesisData& data) {
+  doc::Document page{doc::heading(1, doc::text("The errata ledger"), "errata"), doc::paragraph(doc::link("index", "README.md"))};
+  for (doc::Block& b : errata_document(data.errata, 2)) page.push_back(std::move(b));
+  report.files["errata.md"] = markdown(page, "");
+  latex.add(page);
+}
+
+// The index's row of one case: its limit cycle beside the thesis's and the describing function's.
+std::vector<Rich> case_summary_row(const CaseResult& c, const ThesisData& data) {
+  std::size_t errata_count = 0;
+  for (const Erratum& e : data.errata) errata_count += e.case_id == c.spec.id ? 1 : 0;
+  const bool cycle = c.cycle.status == numeric::CycleStatus::LimitCycle;
+  std::string comparison;
+  if (cycle && c.thesis->limit_cycle_printed != "none")
+    comparison = sig(100 * (printed_number(c.thesis->limit_cycle_printed) / c.cycle.peak_to_peak - 1), 3) + "%";
+  else if (!cycle && c.thesis->limit_cycle_printed == "none")
+    comparison = "agree: none";
+  else
+    comparison = "DISAGREE";
+  const auto predicted = c.describing_function.predicted();
+  return {doc::link(c.spec.id, "cases/" + c.spec.id + ".md"), doc::text(std::to_string(c.thesis->section)),
+          doc::text(model::to_string(c.spec.measured_at)), doc::text(cycle ? "yes" : "none"),
+          doc::text(cycle ? fixed(c.cycle.peak_to_peak, 6) : "—"), doc::text(c.thesis->limit_cycle_printed),
+          doc::text(comparison),
+          doc::text(c.describing_function.applicable ? (predicted ? fixed(predicted->load_peak_to_peak, 6) : "none") : "n/a"),
+          doc::text(std::to_string(errata_count))};
+}
+
+// The index's opening and its table of the eight cases.
+void index_cases(doc::Document& index, const std::vector<CaseResult>& cases, const ThesisData& data) {
+  index.push_back(doc::heading(1, doc::text("backlash report: the thesis's eight cases, exactly")));
+  index.push_back(doc::paragraph(doc::text(
+      "Generated by backlash report from the thesis Dividing lines for backlash in the phase plane (the cases in cases/, "
+      "the thesis's printed numbers in the data files and the errata ledger).  Each case has a page that replaces its "
+      "section of the thesis: the model, the derivation step by step with the thesis's equation numbers, the separation "
+      "line and isoclines, the dividing lines beside the thesis's tables, the step responses and the limit cycle beside "
+      "the thesis's numbers, the describing-function prediction, and the validated generated evaluator.  Every number "
+      "is computed; none is typed by hand.")));
+  index.push_back(doc::paragraph(doc::text(pdf_status_token)));
+  index.push_back(doc::paragraph(doc::text(figures_status_token)));
+  index.push_back(doc::heading(2, doc::text("The eight cases")));
+  std::vector<std::vector<Rich>> rows;
+  for (const CaseResult& c : cases) rows.push_back(case_summary_row(c, data));
+  index.push_back(doc::table({doc::text("case"), doc::text("section"), doc::text("output at"), doc::text("limit cycle"),
+                              doc::text("exact magnitude (peak-to-peak θo)"), doc::text("thesis (section 14)"),
+                              doc::text("thesis vs exact"), doc::text("describing function"), doc::text("errata")},
+                             rows, "lrllrrrrr"));
+  index.back().latex_columns = "lrllp{2.2cm}p{1.6cm}p{1.6cm}p{2.2cm}r";
+  index.push_back(doc::paragraph(
+      doc::text("The describing function (the classical prediction, see each case page) gives the same magnitude for every "
+                "case with the same total inertia, friction, gain and backlash, whatever their split between motor and load; "
+                "the exact cycles differ.")));
+}
+
+// The index's list of pages and files, the table of the redrawn figures and the errata ledger.
+void index_files(doc::Document& index, std::size_t branch_count, const ThesisData& data) {
+  index.push_back(doc::heading(2, doc::text("Pages and files")));
+  index.push_back(doc::list({doc::link("general solutions", "general.md") +
+                                 doc::text(": the " + std::to_string(branch_count) + " pole-structure branches (sections 3–5)"),
+                             doc::link("errata ledger", "errata.md") + doc::text(": every printed number that differs, with its cause"),
+                             doc::text("report.pdf: all of it as one document (when pdflatex is installed)"),
+                             doc::text("derivations/CASE.json, .tex; validation/CASE.json; dividing_lines/CASE.csv; "
+                                       "step_responses/CASE_*.csv; sweeps/fig31.csv, fig32.csv; figures/NAME.svg, .pdf, .csv "
+                                       "(the data of every figure)")}));
+  index.push_back(doc::heading(2, doc::text("The thesis's figures, redrawn")));
+  std::vector<std::vector<Rich>> figure_rows;
+  for (const FigureSpec& f : data.figures)
+    figure_rows.push_back({doc::text(std::to_string(f.number)), doc::text(f.case_id.empty() ? "—" : f.case_id), doc::text(f.what),
+                           doc::link(figure_name(f) + ".svg", "figures/" + figure_name(f) + ".svg")});
+  index.push_back(doc::table({doc::text("fig."), doc::text("case"), doc::text("what the thesis shows"), doc::text("file")},
+                             figure_rows, "rlll"));
+  index.back().latex_columns = "rlp{9cm}p{5cm}";
+  index.back().small = true;
+  index.push_back(doc::heading(2, doc::text("The errata ledger in full")));
+  for (doc::Block& b : errata_document(data.errata, 3)) index.push_back(std::move(b));
+}
+
 }  // namespace
 
 BuiltReport build_report(const DataPaths& paths) {
@@ -210,160 +384,21 @@ BuiltReport build_report(const DataPaths& paths) {
     sweeps = compute_sweeps();
   }
 
-  std::ostringstream latex;
-  latex << latex_preamble();
-  doc::LatexOptions latex_options;
-  latex_options.top_level = 1;  // page heading 1 → \section
-
-  // ---- the case pages and their machine-readable outputs
+  LatexBook latex;
   PhaseTimer pages_timer("pages");
-  for (const CaseResult& c : cases) {
-    const std::string& id = c.spec.id;
-    PhaseTimer case_timer("  case page");
-    const doc::Document page = case_document(c, data);
-    report.files["cases/" + id + ".md"] = markdown(page, "../");
-    report.case_pages[id] = "cases/" + id + ".md";
-    report.case_equations[id] = c.thesis->equations;
-    latex << "\\clearpage\n" << doc::to_latex(page, latex_options);
-    for (Plot& plot : case_figures(c, data)) report.figures.push_back(std::move(plot));
-
-    report.files["derivations/" + id + ".json"] = symbolic::to_json(c.derivation).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
-    report.files["derivations/" + id + ".tex"] = symbolic::to_latex(c.derivation);
-    nlohmann::json v{{"case", id}, {"evaluator", c.validation.report().evaluator}, {"passed", c.validation.passed()}};
-    for (const numeric::StateError& s : c.validation.report().states)
-      v["states"].push_back({{"state", s.state}, {"max_abs_error", s.max_abs_error}, {"at_t", s.at_t}, {"passed", s.passed}});
-    report.files["validation/" + id + ".json"] = v.dump(2) + "\n";
-    std::ostringstream lines;
-    lines << "v0,status,t,theta_m,dtheta_m,theta_L,dtheta_L,theta_o,dtheta_o\n";
-    for (const numeric::DividingLines* l : {&c.lines_negative, &c.lines_positive})
-      for (const numeric::DividingLinePoint& q : l->points)
-        lines << csv_number(q.dtheta_m0) << "," << numeric::to_string(q.status) << "," << csv_number(q.t) << "," << csv_number(q.theta_m) << ","
-              << csv_number(q.dtheta_m) << "," << csv_number(q.theta_L) << "," << csv_number(q.dtheta_L) << "," << csv_number(q.theta_o)
-              << "," << csv_number(q.dtheta_o) << "\n";
-    report.files["dividing_lines/" + id + ".csv"] = lines.str();
-    for (const TrajectoryRun& run : c.runs) {
-      std::ostringstream csv;
-      csv << "t,theta_o,dtheta_o,theta_m,dtheta_m,theta_L,dtheta_L,mode\n";
-      for (const numeric::TrajectorySample& s : run.result.samples)
-        csv << csv_number(s.t) << "," << csv_number(s.theta_o) << "," << csv_number(s.dtheta_o) << "," << csv_number(s.theta_m) << ","
-            << csv_number(s.dtheta_m) << "," << csv_number(s.theta_L) << "," << csv_number(s.dtheta_L) << ","
-            << (s.in_contact ? "contact" : "free") << "\n";
-      std::string name = run.label;
-      for (char& ch : name)
-        if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '-') ch = '_';
-      report.files["step_responses/" + id + "_" + name + ".csv"] = csv.str();
-    }
-  }
-
-  // ---- the general solutions
-  {
-    PhaseTimer timer("general page");
-    const doc::Document page = general_page(branches);
-    report.files["general.md"] = markdown(page, "");
-    latex << "\\clearpage\n" << doc::to_latex(page, latex_options);
-    nlohmann::json all = nlohmann::json::array();
-    std::string tex;
-    for (const symbolic::GeneralBranch& b : branches) {
-      all.push_back(symbolic::to_json(b));
-      tex += symbolic::to_latex(b) + "\n";
-    }
-    report.files["derivations/general.json"] = all.dump(2) + "\n";
-    report.files["derivations/general.tex"] = tex;
-  }
-
-  // ---- the sweeps (figs. 31, 32)
+  for (const CaseResult& c : cases) add_case(report, latex, c, data);
+  add_general(report, latex, branches);
+  // the sweeps (figs. 31, 32)
   for (Plot& plot : sweep_figures(sweeps, cases, data)) report.figures.push_back(std::move(plot));
-  for (const SweepResult& s : sweeps) {
-    std::ostringstream csv;
-    csv << "series,x,Jm,Fm,JL,FL,status,peak_to_peak,period,multiplier\n";
-    for (const numeric::SweepRow& r : s.rows) {
-      const numeric::Parameters& q = r.point.parameters;
-      csv << symbolic::escape::csv_field(r.point.series) << "," << csv_number(r.point.x) << "," << csv_number(q.Jm) << "," << csv_number(q.Fm)
-          << "," << csv_number(q.JL) << "," << csv_number(q.FL) << "," << symbolic::escape::csv_field(numeric::to_string(r.status));
-      if (r.status == numeric::SweepStatus::LimitCycle)
-        csv << "," << csv_number(r.cycle.peak_to_peak) << "," << csv_number(r.cycle.period) << "," << csv_number(r.cycle.multiplier) << "\n";
-      else
-        csv << ",,,\n";
-    }
-    report.files["sweeps/" + s.name + ".csv"] = csv.str();
-  }
+  for (const SweepResult& s : sweeps) report.files["sweeps/" + s.name + ".csv"] = sweep_csv(s);
+  add_errata(report, latex, data);
+  doc::Document index;
+  index_cases(index, cases, data);
+  index_files(index, branches.size(), data);
+  report.files["README.md"] = markdown(index, "");
 
-  // ---- the errata ledger
-  {
-    doc::Document page{doc::heading(1, doc::text("The errata ledger"), "errata"),
-                       doc::paragraph(doc::link("index", "README.md"))};
-    for (doc::Block& b : errata_document(data.errata, 2)) page.push_back(std::move(b));
-    report.files["errata.md"] = markdown(page, "");
-    latex << "\\clearpage\n" << doc::to_latex(page, latex_options);
-  }
-
-  // ---- the index
-  {
-    doc::Document index;
-    index.push_back(doc::heading(1, doc::text("backlash report: the thesis's eight cases, exactly")));
-    index.push_back(doc::paragraph(doc::text(
-        "Generated by backlash report from the thesis Dividing lines for backlash in the phase plane (the cases in cases/, "
-        "the thesis's printed numbers in the data files and the errata ledger).  Each case has a page that replaces its "
-        "section of the thesis: the model, the derivation step by step with the thesis's equation numbers, the separation "
-        "line and isoclines, the dividing lines beside the thesis's tables, the step responses and the limit cycle beside "
-        "the thesis's numbers, the describing-function prediction, and the validated generated evaluator.  Every number "
-        "is computed; none is typed by hand.")));
-    index.push_back(doc::paragraph(doc::text(pdf_status_token)));
-    index.push_back(doc::paragraph(doc::text(figures_status_token)));
-    index.push_back(doc::heading(2, doc::text("The eight cases")));
-    std::vector<std::vector<Rich>> rows;
-    for (const CaseResult& c : cases) {
-      std::size_t errata_count = 0;
-      for (const Erratum& e : data.errata) errata_count += e.case_id == c.spec.id ? 1 : 0;
-      const bool cycle = c.cycle.status == numeric::CycleStatus::LimitCycle;
-      std::string comparison;
-      if (cycle && c.thesis->limit_cycle_printed != "none")
-        comparison = sig(100 * (printed_number(c.thesis->limit_cycle_printed) / c.cycle.peak_to_peak - 1), 3) + "%";
-      else if (!cycle && c.thesis->limit_cycle_printed == "none")
-        comparison = "agree: none";
-      else
-        comparison = "DISAGREE";
-      const auto predicted = c.describing_function.predicted();
-      rows.push_back({doc::link(c.spec.id, "cases/" + c.spec.id + ".md"), doc::text(std::to_string(c.thesis->section)),
-                      doc::text(model::to_string(c.spec.measured_at)), doc::text(cycle ? "yes" : "none"),
-                      doc::text(cycle ? fixed(c.cycle.peak_to_peak, 6) : "—"), doc::text(c.thesis->limit_cycle_printed),
-                      doc::text(comparison),
-                      doc::text(c.describing_function.applicable ? (predicted ? fixed(predicted->load_peak_to_peak, 6) : "none") : "n/a"),
-                      doc::text(std::to_string(errata_count))});
-    }
-    index.push_back(doc::table({doc::text("case"), doc::text("section"), doc::text("output at"), doc::text("limit cycle"),
-                                doc::text("exact magnitude (peak-to-peak θo)"), doc::text("thesis (section 14)"),
-                                doc::text("thesis vs exact"), doc::text("describing function"), doc::text("errata")},
-                               rows, "lrllrrrrr"));
-    index.back().latex_columns = "lrllp{2.2cm}p{1.6cm}p{1.6cm}p{2.2cm}r";
-    index.push_back(doc::paragraph(
-        doc::text("The describing function (the classical prediction, see each case page) gives the same magnitude for every "
-                  "case with the same total inertia, friction, gain and backlash, whatever their split between motor and load; "
-                  "the exact cycles differ.")));
-    index.push_back(doc::heading(2, doc::text("Pages and files")));
-    index.push_back(doc::list({doc::link("general solutions", "general.md") +
-                                   doc::text(": the " + std::to_string(branches.size()) + " pole-structure branches (sections 3–5)"),
-                               doc::link("errata ledger", "errata.md") + doc::text(": every printed number that differs, with its cause"),
-                               doc::text("report.pdf: all of it as one document (when pdflatex is installed)"),
-                               doc::text("derivations/CASE.json, .tex; validation/CASE.json; dividing_lines/CASE.csv; "
-                                         "step_responses/CASE_*.csv; sweeps/fig31.csv, fig32.csv; figures/NAME.svg, .pdf, .csv "
-                                         "(the data of every figure)")}));
-    index.push_back(doc::heading(2, doc::text("The thesis's figures, redrawn")));
-    std::vector<std::vector<Rich>> figure_rows;
-    for (const FigureSpec& f : data.figures)
-      figure_rows.push_back({doc::text(std::to_string(f.number)), doc::text(f.case_id.empty() ? "—" : f.case_id), doc::text(f.what),
-                             doc::link(figure_name(f) + ".svg", "figures/" + figure_name(f) + ".svg")});
-    index.push_back(doc::table({doc::text("fig."), doc::text("case"), doc::text("what the thesis shows"), doc::text("file")},
-                               figure_rows, "rlll"));
-    index.back().latex_columns = "rlp{9cm}p{5cm}";
-    index.back().small = true;
-    index.push_back(doc::heading(2, doc::text("The errata ledger in full")));
-    for (doc::Block& b : errata_document(data.errata, 3)) index.push_back(std::move(b));
-    report.files["README.md"] = markdown(index, "");
-  }
-
-  latex << "\\end{document}\n";
-  report.latex_document = latex.str();
+  latex.text << "\\end{document}\n";
+  report.latex_document = latex.text.str();
   for (const Plot& plot : report.figures) report.files["figures/" + plot.name + ".csv"] = figure_csv(plot);
   return report;
 }

@@ -420,8 +420,101 @@ struct SegmentView {
   std::string checks_prefix;         // "contact:", "free motor:", "free load:"
 };
 
-doc::Document segment_blocks(const SegmentView& v, const CaseParameters& p, const RadicalList& radicals,
-                             const std::vector<VerificationCheck>& checks, const EquationTags& tags, int level) {
+std::string with_tag(std::string body, const std::string& t) { return t.empty() ? body : body + " \\tag{" + t + "}"; }
+
+// The transform solved as one rational function and its denominator factored.
+void transform_blocks(doc::Document& out, const SegmentView& v, const SegmentSteps& steps, const EquationTags& tags) {
+  out.push_back(doc::paragraph(doc::text("Solved for the transform, as one rational function in lowest terms:")));
+  out.push_back(doc::equation(with_tag(v.laplace_lhs + " = " + pp::print(steps.transform), tag(tags, v.key + "_transform"))));
+  const std::string denominator = pp::print(steps.transform.denominator), factored = factored_latex(steps);
+  const std::string factored_tag = tag(tags, v.key + "_factored");
+  if (factored == denominator || factored == "\\left(" + denominator + "\\right)") {
+    // one linear factor (s, 5s + 3): nothing to factor, and "s = s" reads as a slip
+    out.push_back(doc::paragraph(doc::text("Its denominator is already a single linear factor: ") + doc::math(denominator) +
+                                 doc::text(".")));
+    if (!factored_tag.empty()) out.push_back(doc::equation(with_tag(denominator, factored_tag)));
+  } else {
+    out.push_back(doc::paragraph(doc::text("Its denominator factored:")));
+    out.push_back(doc::equation(with_tag(denominator + " = " + factored, factored_tag)));
+  }
+}
+
+// The term of the solution that the coefficient A_r at one pole location gives (a complex pair: twice the real part).
+TimeFunction residue_term(const PoleResidues& row, const ex& at, const ex& A, std::size_t r, const SegmentSteps& steps) {
+  const symbol& i = imaginary_unit().symbol;
+  const numeric fact = factorial(numeric(static_cast<int>(r - 1)));
+  if (row.pole.kind != Pole::Kind::ComplexPair)
+    return TimeFunction({{A / fact, static_cast<unsigned>(r - 1), at, Oscillation::None, 0}});
+  const ex a = A / fact;
+  const ex re = simplify(a.subs(i == 0), steps.radicals), im = simplify(a.coeff(i, 1), steps.radicals);
+  return TimeFunction({{2 * re, static_cast<unsigned>(r - 1), row.pole.center, Oscillation::Cos, row.pole.half_width},
+                       {-2 * im, static_cast<unsigned>(r - 1), row.pole.center, Oscillation::Sin, row.pole.half_width}});
+}
+
+// The poles, their partial-fraction coefficients and terms, and the partial fractions.
+void residue_blocks(doc::Document& out, const SegmentView& v, const SegmentSteps& steps, const EquationTags& tags) {
+  std::vector<Rich> header{doc::text("pole"), doc::text("multiplicity"), doc::text("power r"),
+                           doc::text("coefficient of ") + doc::math("1/(s-p)^r"), doc::text("term of the solution")};
+  std::vector<std::vector<Rich>> rows;
+  for (const PoleResidues& row : steps.poles) {
+    for (const auto& location : row.locations) {
+      for (std::size_t r = 1; r <= location.coefficients.size(); ++r) {
+        const ex A = location.coefficients[r - 1];
+        std::string where = pp::latex(with_explicit_radicals(location.at, steps.radicals));
+        if (row.pole.kind == Pole::Kind::ComplexPair) where = pole_latex(row.pole, steps.radicals);
+        const TimeFunction term = residue_term(row, location.at, A, r, steps);
+        rows.push_back({doc::math(where), doc::text(std::to_string(row.pole.multiplicity)), doc::text(std::to_string(r)),
+                        doc::math(complex_latex(A, steps.radicals)),
+                        doc::math(pp::time_function(term, steps.radicals, pp::latex_exact))});
+      }
+    }
+  }
+  out.push_back(doc::paragraph(doc::text("Poles (multiplicity) and partial-fraction coefficients ") +
+                               doc::math("A_r = \\frac{1}{(m-r)!}\\frac{d^{m-r}}{ds^{m-r}}\\left[(s-p)^m F(s)\\right]_{s=p}") +
+                               doc::text(" (a complex pair by its coefficient at the upper pole; the term is twice the real part):")));
+  out.push_back(doc::table(header, rows, "lrrll"));
+  // ragged right: a long coefficient breaks after a "+" and the "+" stays beside it
+  out.back().latex_columns = "p{2.6cm}rr>{\\raggedright\\arraybackslash}p{4.4cm}>{\\raggedright\\arraybackslash}p{5.6cm}";
+  out.back().small = true;
+  out.push_back(doc::paragraph(doc::text("The partial fractions:")));
+  out.push_back(doc::equation(pp::display(v.laplace_lhs, partial_fraction_terms(steps, pp::latex_exact),
+                                          tag(tags, v.key + "_partial"))));
+}
+
+// The time-domain result, exactly and in decimals (the decimal line with ≈).
+void time_domain_blocks(doc::Document& out, const SegmentView& v, const RadicalList& radicals, const EquationTags& tags) {
+  out.push_back(doc::paragraph(doc::text("The time-domain result, exactly and in decimals:")));
+  out.push_back(doc::equation(pp::display(v.time_lhs, pp::time_function_terms(v.segment->solution, radicals, pp::latex_exact),
+                                          tag(tags, v.key))));
+  out.push_back(doc::equation(pp::display(v.time_lhs, pp::time_function_terms(v.segment->solution, radicals, latex6, false))));
+  std::string& last = out.back().equation;
+  const std::string eq = v.time_lhs + " = ";
+  if (last.rfind(eq, 0) == 0) last.replace(0, eq.size(), v.time_lhs + " \\approx ");
+  const std::string aligned = "\\begin{aligned}" + v.time_lhs + " &= ";
+  if (last.rfind(aligned, 0) == 0) last.replace(0, aligned.size(), "\\begin{aligned}" + v.time_lhs + " &\\approx ");
+}
+
+// The segment's exact self-checks: the steps' own two and the derivation's checks of this segment.
+void self_check_blocks(doc::Document& out, const SegmentView& v, const SegmentSteps* steps, const std::vector<VerificationCheck>& checks) {
+  std::vector<Rich> passed;
+  if (steps) {
+    passed.push_back(doc::text(steps->partial_fractions_sum_to_transform ? "passed: " : "FAILED: ") +
+                     doc::text("the partial fractions add up to the transform exactly"));
+    passed.push_back(doc::text(steps->residues_give_solution ? "passed: " : "FAILED: ") +
+                     doc::text("the terms of the table are the solution, term by term"));
+  }
+  for (const VerificationCheck& c : checks) {
+    const bool velocity_check = c.name.find("L^-1[s*") != std::string::npos;
+    const bool mine = c.name.rfind(v.checks_prefix, 0) == 0 && velocity_check == (v.key[0] == 'd');
+    if (!mine) continue;
+    passed.push_back(doc::text(c.passed ? "passed: " : "FAILED: ") + check_rich(c.name));
+  }
+  out.push_back(doc::paragraph(doc::text("Exact self-checks (each reduces to 0 in exact arithmetic):")));
+  out.push_back(doc::list(passed));
+}
+
+doc::Document segment_blocks(const SegmentView& v, const RadicalList& radicals, const std::vector<VerificationCheck>& checks,
+                             const EquationTags& tags, int level) {
   doc::Document out;
   out.push_back(doc::heading(level, v.title));
   if (!v.transformed_equation.empty()) {
@@ -439,124 +532,33 @@ doc::Document segment_blocks(const SegmentView& v, const CaseParameters& p, cons
     have_steps = false;
     out.push_back(doc::paragraph(doc::text(std::string("(steps not available: ") + e.what() + ")")));
   }
-  const symbol& s = derivation_symbols().s;
-  (void)p;
   if (have_steps) {
-    out.push_back(doc::paragraph(doc::text("Solved for the transform, as one rational function in lowest terms:")));
-    out.push_back(doc::equation(v.laplace_lhs + " = " + pp::print(steps.transform) +
-                                (tag(tags, v.key + "_transform").empty() ? "" : " \\tag{" + tag(tags, v.key + "_transform") + "}")));
-    const std::string denominator = pp::print(steps.transform.denominator), factored = factored_latex(steps);
-    const std::string factored_tag = tag(tags, v.key + "_factored").empty() ? "" : " \\tag{" + tag(tags, v.key + "_factored") + "}";
-    if (factored == denominator || factored == "\\left(" + denominator + "\\right)") {
-      // one linear factor (s, 5s + 3): nothing to factor, and "s = s" reads as a slip
-      out.push_back(doc::paragraph(doc::text("Its denominator is already a single linear factor: ") + doc::math(denominator) +
-                                   doc::text(".")));
-      if (!factored_tag.empty()) out.push_back(doc::equation(denominator + factored_tag));
-    } else {
-      out.push_back(doc::paragraph(doc::text("Its denominator factored:")));
-      out.push_back(doc::equation(denominator + " = " + factored + factored_tag));
-    }
-    std::vector<Rich> header{doc::text("pole"), doc::text("multiplicity"), doc::text("power r"),
-                             doc::text("coefficient of ") + doc::math("1/(s-p)^r"), doc::text("term of the solution")};
-    std::vector<std::vector<Rich>> rows;
-    const symbol& i = imaginary_unit().symbol;
-    for (const PoleResidues& row : steps.poles) {
-      for (const auto& location : row.locations) {
-        for (std::size_t r = 1; r <= location.coefficients.size(); ++r) {
-          const ex A = location.coefficients[r - 1];
-          std::string where = pp::latex(with_explicit_radicals(location.at, steps.radicals));
-          if (row.pole.kind == Pole::Kind::ComplexPair) where = pole_latex(row.pole, steps.radicals);
-          TimeFunction term;
-          const numeric fact = factorial(numeric(static_cast<int>(r - 1)));
-          if (row.pole.kind == Pole::Kind::ComplexPair) {
-            const ex a = location.coefficients[r - 1] / fact;
-            const ex re = simplify(a.subs(i == 0), steps.radicals), im = simplify(a.coeff(i, 1), steps.radicals);
-            term = TimeFunction({{2 * re, static_cast<unsigned>(r - 1), row.pole.center, Oscillation::Cos, row.pole.half_width},
-                                 {-2 * im, static_cast<unsigned>(r - 1), row.pole.center, Oscillation::Sin, row.pole.half_width}});
-          } else {
-            term = TimeFunction({{location.coefficients[r - 1] / fact, static_cast<unsigned>(r - 1), location.at, Oscillation::None, 0}});
-          }
-          rows.push_back({doc::math(where), doc::text(std::to_string(row.pole.multiplicity)), doc::text(std::to_string(r)),
-                          doc::math(complex_latex(A, steps.radicals)),
-                          doc::math(pp::time_function(term, steps.radicals, pp::latex_exact))});
-        }
-      }
-    }
-    out.push_back(doc::paragraph(doc::text("Poles (multiplicity) and partial-fraction coefficients ") +
-                                 doc::math("A_r = \\frac{1}{(m-r)!}\\frac{d^{m-r}}{ds^{m-r}}\\left[(s-p)^m F(s)\\right]_{s=p}") +
-                                 doc::text(" (a complex pair by its coefficient at the upper pole; the term is twice the real part):")));
-    out.push_back(doc::table(header, rows, "lrrll"));
-    // ragged right: a long coefficient breaks after a "+" and the "+" stays beside it
-    out.back().latex_columns = "p{2.6cm}rr>{\\raggedright\\arraybackslash}p{4.4cm}>{\\raggedright\\arraybackslash}p{5.6cm}";
-    out.back().small = true;
-    out.push_back(doc::paragraph(doc::text("The partial fractions:")));
-    out.push_back(doc::equation(pp::display(v.laplace_lhs, partial_fraction_terms(steps, pp::latex_exact),
-                                            tag(tags, v.key + "_partial"))));
+    transform_blocks(out, v, steps, tags);
+    residue_blocks(out, v, steps, tags);
   }
-  out.push_back(doc::paragraph(doc::text("The time-domain result, exactly and in decimals:")));
-  out.push_back(doc::equation(pp::display(v.time_lhs, pp::time_function_terms(v.segment->solution, radicals, pp::latex_exact),
-                                          tag(tags, v.key))));
-  out.push_back(doc::equation(pp::display(v.time_lhs, pp::time_function_terms(v.segment->solution, radicals, latex6, false))));
-  // the decimal line uses ≈
-  {
-    std::string& last = out.back().equation;
-    const std::string eq = v.time_lhs + " = ";
-    if (last.rfind(eq, 0) == 0) last.replace(0, eq.size(), v.time_lhs + " \\approx ");
-    const std::string aligned = "\\begin{aligned}" + v.time_lhs + " &= ";
-    if (last.rfind(aligned, 0) == 0) last.replace(0, aligned.size(), "\\begin{aligned}" + v.time_lhs + " &\\approx ");
-  }
-  std::vector<Rich> passed;
-  if (have_steps) {
-    passed.push_back(doc::text(steps.partial_fractions_sum_to_transform ? "passed: " : "FAILED: ") +
-                     doc::text("the partial fractions add up to the transform exactly"));
-    passed.push_back(doc::text(steps.residues_give_solution ? "passed: " : "FAILED: ") +
-                     doc::text("the terms of the table are the solution, term by term"));
-  }
-  for (const VerificationCheck& c : checks) {
-    const bool velocity_check = c.name.find("L^-1[s*") != std::string::npos;
-    const bool mine = c.name.rfind(v.checks_prefix, 0) == 0 && velocity_check == (v.key[0] == 'd');
-    if (!mine) continue;
-    passed.push_back(doc::text(c.passed ? "passed: " : "FAILED: ") + check_rich(c.name));
-  }
-  (void)s;
-  out.push_back(doc::paragraph(doc::text("Exact self-checks (each reduces to 0 in exact arithmetic):")));
-  out.push_back(doc::list(passed));
+  time_domain_blocks(out, v, radicals, tags);
+  self_check_blocks(out, v, have_steps ? &steps : nullptr, checks);
   return out;
 }
 
-std::string with_tag(std::string body, const std::string& t) { return t.empty() ? body : body + " \\tag{" + t + "}"; }
+// The model's parameters: symbol, meaning, value as the model file gives it, exact.
+doc::Block parameter_table(const CaseParameters& p) {
+  std::vector<std::vector<Rich>> rows;
+  const std::vector<std::tuple<std::string, std::string, ex>> params{
+      {"J_m", "inertia of the motor (system without load)", p.Jm}, {"F_m", "viscous friction of the motor, back-emf included", p.Fm},
+      {"J_L", "inertia of the load", p.JL},                         {"F_L", "viscous friction of the load", p.FL},
+      {"K", "loop gain", p.K},                                     {"\\theta_R", "reference", p.theta_R},
+      {"b", "total backlash (rad)", p.backlash}};
+  for (const auto& [symbol_latex, meaning, value] : params)
+    rows.push_back({doc::math(symbol_latex), doc::text(meaning), doc::math(model_number_latex(value)),
+                    doc::math(pp::latex(value))});
+  return doc::table({doc::text("symbol"), doc::text("meaning"), doc::text("value"), doc::text("exact")}, rows, "llrr");
+}
 
-}  // namespace
-
-doc::Document derivation_document(const CaseDerivation& d, const EquationTags& tags, int level) {
-  const CaseParameters& p = d.parameters;
-  const RadicalList& r = d.radicals;
+// The equations of motion: contact, the motor with the load separated, the load drifting.
+void motion_equations(doc::Document& out, const CaseParameters& p, const EquationTags& tags) {
   const bool at_motor = p.measured_at == model::MeasuredAt::Motor;
   const ex J = p.Jm + p.JL, F = p.Fm + p.FL;
-  doc::Document out;
-
-  // ---- the model
-  out.push_back(doc::heading(level, doc::text("The model")));
-  out.push_back(doc::paragraph(
-      doc::text(at_motor ? "The output is measured at the motor shaft, " : "The output is measured at the load, ") +
-      doc::math(at_motor ? "\\theta_o = \\theta_m" : "\\theta_o = \\theta_L") +
-      doc::text(at_motor ? ": the backlash is outside the feedback loop and the motor alone is a closed loop when the load "
-                           "has separated."
-                         : ": the backlash is inside the feedback loop and the motor is driven open loop by the load's "
-                           "error while the load drifts in the backlash.") +
-      doc::text(" Gear ratio 1, torques in units of ") + doc::math("K\\cdot\\mathrm{rad}") + doc::text(".")));
-  {
-    std::vector<std::vector<Rich>> rows;
-    const std::vector<std::tuple<std::string, std::string, ex>> params{
-        {"J_m", "inertia of the motor (system without load)", p.Jm}, {"F_m", "viscous friction of the motor, back-emf included", p.Fm},
-        {"J_L", "inertia of the load", p.JL},                         {"F_L", "viscous friction of the load", p.FL},
-        {"K", "loop gain", p.K},                                     {"\\theta_R", "reference", p.theta_R},
-        {"b", "total backlash (rad)", p.backlash}};
-    for (const auto& [symbol_latex, meaning, value] : params)
-      rows.push_back({doc::math(symbol_latex), doc::text(meaning), doc::math(model_number_latex(value)),
-                      doc::math(pp::latex(value))});
-    out.push_back(doc::table({doc::text("symbol"), doc::text("meaning"), doc::text("value"), doc::text("exact")}, rows, "llrr"));
-  }
   out.push_back(doc::paragraph(doc::text("Contact (backlash taken up), the bodies move as one, ") +
                                doc::math("J\\ddot\\theta_o + F\\dot\\theta_o + K\\theta_o = K\\theta_R") + doc::text(" with ") +
                                doc::math("J = J_m + J_L") + doc::text(", ") + doc::math("F = F_m + F_L") + doc::text(":")));
@@ -583,7 +585,11 @@ doc::Document derivation_document(const CaseDerivation& d, const EquationTags& t
                                doc::text(":")));
   out.push_back(doc::equation(with_tag(combination_latex({{p.JL, "\\ddot\\theta_L"}, {p.FL, "\\dot\\theta_L"}}) + " = 0",
                                        tag(tags, "free_load_equation"))));
-  // isoclines (η = θ̈/θ̇)
+}
+
+// The isoclines (η = θ̈/θ̇) of the combined system and, with the output at the motor, of the motor alone.
+void model_isoclines(doc::Document& out, const CaseParameters& p, const EquationTags& tags) {
+  const ex J = p.Jm + p.JL, F = p.Fm + p.FL;
   out.push_back(doc::paragraph(doc::text("Isoclines of the combined system, ") + doc::math("\\eta_1 = \\ddot\\theta_o/\\dot\\theta_o") +
                                doc::text(" constant (straight lines through ") + doc::math("(\\theta_R, 0)") + doc::text("):")));
   out.push_back(doc::equation(with_tag("\\eta_1 + " + pp::latex(F / J) + " = " + coefficient_latex(p.K / J) +
@@ -593,43 +599,44 @@ doc::Document derivation_document(const CaseDerivation& d, const EquationTags& t
     out.push_back(doc::equation(with_tag("\\theta_o = " + model_number_latex(p.theta_R) + " - " + coefficient_latex(J / p.K) +
                                              "\\dot\\theta_o\\left(\\eta_1 + " + pp::latex(F / J) + "\\right)",
                                          tag(tags, "combined_isocline_line"))));
-  if (at_motor) {
-    out.push_back(doc::paragraph(doc::text("Isoclines of the motor alone, ") + doc::math("\\eta_2 = \\ddot\\theta_m/\\dot\\theta_m") +
-                                 doc::text(":")));
-    out.push_back(doc::equation(with_tag("\\eta_2 + " + pp::latex(p.Fm / p.Jm) + " = " + coefficient_latex(p.K / p.Jm) + "\\frac{" +
-                                             model_number_latex(p.theta_R) + " - \\theta_m}{\\dot\\theta_m}",
-                                         tag(tags, "motor_isocline"))));
-    out.push_back(doc::paragraph(doc::text("The motor alone, normalised:")));
-    out.push_back(doc::equation(with_tag(
-        "\\ddot\\theta_m + " + coefficient_latex(p.Fm / p.Jm) + "\\dot\\theta_m + " + coefficient_latex(p.K / p.Jm) + "\\theta_m = " +
-            pp::latex(p.K * p.theta_R / p.Jm),
-        tag(tags, "motor_equation_normalized"))));
-  }
+  if (p.measured_at != model::MeasuredAt::Motor) return;
+  out.push_back(doc::paragraph(doc::text("Isoclines of the motor alone, ") + doc::math("\\eta_2 = \\ddot\\theta_m/\\dot\\theta_m") +
+                               doc::text(":")));
+  out.push_back(doc::equation(with_tag("\\eta_2 + " + pp::latex(p.Fm / p.Jm) + " = " + coefficient_latex(p.K / p.Jm) + "\\frac{" +
+                                           model_number_latex(p.theta_R) + " - \\theta_m}{\\dot\\theta_m}",
+                                       tag(tags, "motor_isocline"))));
+  out.push_back(doc::paragraph(doc::text("The motor alone, normalised:")));
+  out.push_back(doc::equation(with_tag(
+      "\\ddot\\theta_m + " + coefficient_latex(p.Fm / p.Jm) + "\\dot\\theta_m + " + coefficient_latex(p.K / p.Jm) + "\\theta_m = " +
+          pp::latex(p.K * p.theta_R / p.Jm),
+      tag(tags, "motor_equation_normalized"))));
+}
 
-  // ---- radicals
-  out.push_back(doc::heading(level, doc::text("The derivation, step by step")));
+// Section 1: the model, its parameters, equations of motion and isoclines.
+void model_section(doc::Document& out, const CaseParameters& p, const EquationTags& tags, int level) {
+  const bool at_motor = p.measured_at == model::MeasuredAt::Motor;
+  out.push_back(doc::heading(level, doc::text("The model")));
   out.push_back(doc::paragraph(
-      doc::text("Each segment's equation of motion is transformed with its initial state, solved for the transform, "
-                "and inverted by residues at the poles of the factored denominator; every result is checked exactly.  "
-                "Free motion starts on the separation line: ") +
-      doc::math("\\theta_m(0) = \\theta_L(0) = \\theta_0 = \\theta_R + \\cot\\varphi\\,\\dot\\theta_{m0} = " +
-                pp::latex(d.free.separation_theta)) +
-      doc::text(", ") + doc::math("\\dot\\theta_m(0) = \\dot\\theta_L(0) = \\dot\\theta_{m0}") +
-      doc::text("; contact starts from ") + doc::math("(\\theta_{o0}, \\dot\\theta_{o0})") + doc::text(".")));
-  if (!r.empty()) {
-    std::vector<Rich> items;
-    for (const Radical& rad : r)
-      items.push_back(doc::math(pp::latex_symbol_name(rad.symbol.get_name()) + " = \\sqrt{" + pp::latex(rad.square) + "} = " +
-                                pp::latex(canonical_sqrt(rad.square)) + " \\approx " +
-                                pp::decimal(to_double(rad.symbol, r), 9)) +
-                      radical_meaning(rad));
-    out.push_back(doc::paragraph(doc::text("Square roots are kept exact and named:")));
-    out.push_back(doc::list(items));
-  }
+      doc::text(at_motor ? "The output is measured at the motor shaft, " : "The output is measured at the load, ") +
+      doc::math(at_motor ? "\\theta_o = \\theta_m" : "\\theta_o = \\theta_L") +
+      doc::text(at_motor ? ": the backlash is outside the feedback loop and the motor alone is a closed loop when the load "
+                           "has separated."
+                         : ": the backlash is inside the feedback loop and the motor is driven open loop by the load's "
+                           "error while the load drifts in the backlash.") +
+      doc::text(" Gear ratio 1, torques in units of ") + doc::math("K\\cdot\\mathrm{rad}") + doc::text(".")));
+  out.push_back(parameter_table(p));
+  motion_equations(out, p, tags);
+  model_isoclines(out, p, tags);
+}
+
+// The six segments the derivation solves: contact θo and θ̇o, the free motor and the free load, each with its transformed equation.
+std::vector<SegmentView> segment_views(const CaseDerivation& d) {
+  const CaseParameters& p = d.parameters;
+  const bool at_motor = p.measured_at == model::MeasuredAt::Motor;
+  const ex J = p.Jm + p.JL, F = p.Fm + p.FL;
   const std::string Jc = coefficient_latex(J), Fc = coefficient_latex(F);
   auto poly = [](const ex& e) { return pp::latex(expand(e)); };
   const symbol& s = derivation_symbols().s;
-  const std::string theta0 = "\\theta_0";
   std::vector<SegmentView> views;
   views.push_back({&d.contact.position, "theta_o", doc::text("Contact mode: the measured shaft ") + doc::math("\\theta_o(t)") + doc::text(" from ") + doc::math("(\\theta_{o0}, \\dot\\theta_{o0})"), "\\theta_o(t)",
                    "\\Theta_o(s)",
@@ -653,12 +660,46 @@ doc::Document derivation_document(const CaseDerivation& d, const EquationTags& t
                    "free load:"});
   views.push_back({&d.free.load_velocity, "dtheta_L", doc::text("Free mode: the load's velocity ") + doc::math("\\dot\\theta_L(t)"), "\\dot\\theta_L(t)", "\\dot\\Theta_L(s)",
                    "\\dot\\Theta_L(s) = s\\,\\Theta_L(s) - \\theta_0", "free load:"});
-  (void)theta0;
-  for (const SegmentView& v : views)
-    for (doc::Block& b : segment_blocks(v, p, r, d.checks, tags, level + 1)) out.push_back(std::move(b));
+  return views;
+}
 
-  // ---- separation line, isoclines, momentum, stability
-  out.push_back(doc::heading(level, doc::text("Separation line, isoclines, momentum balance, stability constant")));
+// Section 2: the derivation step by step, its named radicals and every segment.
+void steps_section(doc::Document& out, const CaseDerivation& d, const EquationTags& tags, int level) {
+  const RadicalList& r = d.radicals;
+  out.push_back(doc::heading(level, doc::text("The derivation, step by step")));
+  out.push_back(doc::paragraph(
+      doc::text("Each segment's equation of motion is transformed with its initial state, solved for the transform, "
+                "and inverted by residues at the poles of the factored denominator; every result is checked exactly.  "
+                "Free motion starts on the separation line: ") +
+      doc::math("\\theta_m(0) = \\theta_L(0) = \\theta_0 = \\theta_R + \\cot\\varphi\\,\\dot\\theta_{m0} = " +
+                pp::latex(d.free.separation_theta)) +
+      doc::text(", ") + doc::math("\\dot\\theta_m(0) = \\dot\\theta_L(0) = \\dot\\theta_{m0}") +
+      doc::text("; contact starts from ") + doc::math("(\\theta_{o0}, \\dot\\theta_{o0})") + doc::text(".")));
+  if (!r.empty()) {
+    std::vector<Rich> items;
+    for (const Radical& rad : r)
+      items.push_back(doc::math(pp::latex_symbol_name(rad.symbol.get_name()) + " = \\sqrt{" + pp::latex(rad.square) + "} = " +
+                                pp::latex(canonical_sqrt(rad.square)) + " \\approx " +
+                                pp::decimal(to_double(rad.symbol, r), 9)) +
+                      radical_meaning(rad));
+    out.push_back(doc::paragraph(doc::text("Square roots are kept exact and named:")));
+    out.push_back(doc::list(items));
+  }
+  for (const SegmentView& v : segment_views(d))
+    for (doc::Block& b : segment_blocks(v, r, d.checks, tags, level + 1)) out.push_back(std::move(b));
+}
+
+// The checks whose name starts with `prefix` (all of them for ""), as a list of passed/FAILED items.
+doc::Block checks_list(const std::vector<VerificationCheck>& checks, const std::string& prefix) {
+  std::vector<Rich> items;
+  for (const VerificationCheck& c : checks)
+    if (c.name.rfind(prefix, 0) == 0) items.push_back(doc::text(c.passed ? "passed: " : "FAILED: ") + check_rich(c.name));
+  return doc::list(items);
+}
+
+// Section 3, first part: the separation line from the three slopes (eqs. of η2 = η3), its tangent and angle.
+void separation_line_blocks(doc::Document& out, const CaseDerivation& d, const EquationTags& tags) {
+  const CaseParameters& p = d.parameters;
   out.push_back(doc::paragraph(doc::text("The load separates where its free deceleration ratio is reached:")));
   out.push_back(doc::equation(with_tag("\\eta_3 = \\frac{\\ddot\\theta_L}{\\dot\\theta_L} = -\\frac{F_L}{J_L} = " +
                                            pp::latex(d.free.eta_separation),
@@ -669,104 +710,115 @@ doc::Document derivation_document(const CaseDerivation& d, const EquationTags& t
   out.push_back(doc::equation(with_tag("\\eta_2 + " + pp::latex(p.Fm / p.Jm) + " = " + coefficient_latex(p.K / p.Jm) + "\\frac{" +
                                            model_number_latex(p.theta_R) + " - \\theta_{m0}}{\\dot\\theta_{m0}}",
                                        tag(tags, "separation_isocline"))));
-  {
-    const bool infinite = normal(d.free.eta_separation + p.Fm / p.Jm).is_zero();
-    const ex tangent_value = infinite ? ex(0) : normal((p.K / p.Jm) / (d.free.eta_separation + p.Fm / p.Jm));
-    out.push_back(doc::equation(with_tag(
-        "\\frac{\\dot\\theta_{m0}}{" + model_number_latex(p.theta_R) + " - \\theta_{m0}} = \\frac{" + pp::latex(p.K / p.Jm) +
-            "}{\\eta_2 + " + pp::latex(p.Fm / p.Jm) + "} = " + (infinite ? std::string("\\infty") : pp::latex(tangent_value)),
-        tag(tags, "separation_tangent"))));
-    const double psi = infinite ? 90.0 : std::atan(to_double(tangent_value, r)) * 180.0 / M_PI;
-    out.push_back(doc::equation(with_tag("\\arctan\\frac{\\dot\\theta_{m0}}{" + model_number_latex(p.theta_R) +
-                                             " - \\theta_{m0}} = " + pp::decimal(psi, 6) + "^\\circ, \\qquad \\varphi = " +
-                                             pp::decimal(phi_degrees(d), 6) + "^\\circ",
-                                         tag(tags, "separation_angle"))));
-  }
+  const bool infinite = normal(d.free.eta_separation + p.Fm / p.Jm).is_zero();
+  const ex tangent_value = infinite ? ex(0) : normal((p.K / p.Jm) / (d.free.eta_separation + p.Fm / p.Jm));
+  out.push_back(doc::equation(with_tag(
+      "\\frac{\\dot\\theta_{m0}}{" + model_number_latex(p.theta_R) + " - \\theta_{m0}} = \\frac{" + pp::latex(p.K / p.Jm) +
+          "}{\\eta_2 + " + pp::latex(p.Fm / p.Jm) + "} = " + (infinite ? std::string("\\infty") : pp::latex(tangent_value)),
+      tag(tags, "separation_tangent"))));
+  const double psi = infinite ? 90.0 : std::atan(to_double(tangent_value, d.radicals)) * 180.0 / M_PI;
+  out.push_back(doc::equation(with_tag("\\arctan\\frac{\\dot\\theta_{m0}}{" + model_number_latex(p.theta_R) +
+                                           " - \\theta_{m0}} = " + pp::decimal(psi, 6) + "^\\circ, \\qquad \\varphi = " +
+                                           pp::decimal(phi_degrees(d), 6) + "^\\circ",
+                                       tag(tags, "separation_angle"))));
   out.push_back(doc::paragraph(doc::text("So the separation line is")));
   out.push_back(doc::equation("\\theta_o = \\theta_R + \\cot\\varphi\\,\\dot\\theta_o, \\qquad \\cot\\varphi = \\frac{J_m F_L - F_m J_L}{K J_L} = " +
                               pp::latex(d.free.cot_phi) + ", \\qquad \\eta_1 = \\eta_2 = \\eta_3 = " +
                               pp::latex(d.free.eta_separation)));
-  {
-    std::vector<Rich> items;
-    for (const VerificationCheck& c : d.checks)
-      if (c.name.rfind("separation line:", 0) == 0) items.push_back(doc::text(c.passed ? "passed: " : "FAILED: ") + check_rich(c.name));
-    out.push_back(doc::paragraph(doc::text("Exact checks on the line (the three slopes coincide, the transmitted torque vanishes):")));
-    out.push_back(doc::list(items));
+  out.push_back(doc::paragraph(doc::text("Exact checks on the line (the three slopes coincide, the transmitted torque vanishes):")));
+  out.push_back(checks_list(d.checks, "separation line:"));
+}
+
+// The isocline table: tangent and angle per slope η, combined system beside the motor alone.
+void isocline_table(doc::Document& out, const CaseDerivation& d) {
+  if (d.isoclines.size() != 2) return;
+  const IsoclineTable &c = d.isoclines[0], &m = d.isoclines[1];
+  std::vector<std::vector<Rich>> rows;
+  auto cell_tangent = [](const IsoclineRow& row) {
+    if (row.is_vertical) return doc::math("\\infty");
+    return doc::math(pp::latex(row.tangent));
+  };
+  for (std::size_t k = 0; k < c.rows.size() && k < m.rows.size(); ++k) {
+    const IsoclineRow &a = c.rows[k], &b = m.rows[k];
+    rows.push_back({doc::math(a.is_infinite ? "\\infty" : pp::latex(a.eta)), cell_tangent(a),
+                    doc::math(pp::decimal(to_double(a.angle_degrees, {}), 5) + "^\\circ"), cell_tangent(b),
+                    doc::math(pp::decimal(to_double(b.angle_degrees, {}), 5) + "^\\circ")});
   }
-  // isocline table
-  if (d.isoclines.size() == 2) {
-    const IsoclineTable &c = d.isoclines[0], &m = d.isoclines[1];
-    std::vector<std::vector<Rich>> rows;
-    auto cell_tangent = [](const IsoclineRow& row) {
-      if (row.is_vertical) return doc::math("\\infty");
-      return doc::math(pp::latex(row.tangent));
-    };
-    for (std::size_t k = 0; k < c.rows.size() && k < m.rows.size(); ++k) {
-      const IsoclineRow &a = c.rows[k], &b = m.rows[k];
-      rows.push_back({doc::math(a.is_infinite ? "\\infty" : pp::latex(a.eta)), cell_tangent(a),
-                      doc::math(pp::decimal(to_double(a.angle_degrees, {}), 5) + "^\\circ"), cell_tangent(b),
-                      doc::math(pp::decimal(to_double(b.angle_degrees, {}), 5) + "^\\circ")});
-    }
-    out.push_back(doc::paragraph(doc::text("Isocline slopes: on the isocline of slope ") + doc::math("\\eta") +
-                                 doc::text(", ") + doc::math("\\dot\\theta/(\\theta - \\theta_R) = -(K/J)/(\\eta + F/J)") +
-                                 doc::text(" and its angle ") + doc::math("\\psi = \\arctan\\dot\\theta/(\\theta-\\theta_R)") +
-                                 doc::text(" (combined system: ") + doc::math("J, F") + doc::text("; motor alone: ") +
-                                 doc::math("J_m, F_m") + doc::text(").")));
-    out.push_back(doc::table({doc::math("\\eta"), doc::text("combined: tangent"), doc::math("\\psi_1"),
-                              doc::text("motor alone: tangent"), doc::math("\\psi_2")},
-                             rows, "rrrrr"));
-    out.back().small = true;
+  out.push_back(doc::paragraph(doc::text("Isocline slopes: on the isocline of slope ") + doc::math("\\eta") +
+                               doc::text(", ") + doc::math("\\dot\\theta/(\\theta - \\theta_R) = -(K/J)/(\\eta + F/J)") +
+                               doc::text(" and its angle ") + doc::math("\\psi = \\arctan\\dot\\theta/(\\theta-\\theta_R)") +
+                               doc::text(" (combined system: ") + doc::math("J, F") + doc::text("; motor alone: ") +
+                               doc::math("J_m, F_m") + doc::text(").")));
+  out.push_back(doc::table({doc::math("\\eta"), doc::text("combined: tangent"), doc::math("\\psi_1"),
+                            doc::text("motor alone: tangent"), doc::math("\\psi_2")},
+                           rows, "rrrrr"));
+  out.back().small = true;
+}
+
+// Eq. 38 with the case's numbers: C = (1/ωc)·sqrt(θ̇o² − (F/J)θ̇o e + (K/J)e²)·exp((a/ωc) arctan((θ̇o − a e)/(ωc e))).
+std::string stability_constant_numbers(const CaseParameters& p, const Radical& omega) {
+  const ex J = p.Jm + p.JL, F = p.Fm + p.FL;
+  const ex a = F / (2 * J);
+  const ex w = canonical_sqrt(omega.square);
+  // c·body with the case's numbers: "e^{2}" for 1·e², nothing for 0 (no "1\,e^{2}", no "- 0\,…")
+  const auto times = [](const ex& c, const std::string& body) {
+    return c.is_zero() ? std::string() : (c.is_equal(1) ? body : pp::latex(c) + "\\," + body);
+  };
+  const std::string damping = (F / J).is_zero() ? "" : " - " + times(F / J, "\\dot\\theta_o e");
+  const std::string shift = a.is_zero() ? "" : " - " + times(a, "e");
+  return "C = " + pp::latex(1 / w) + "\\sqrt{\\dot\\theta_o^{2}" + damping + " + " + times(p.K / J, "e^{2}") +
+         "}\\;\\exp\\left(" + pp::latex(a / w) + "\\arctan\\frac{\\dot\\theta_o" + shift + "}{" + times(w, "e") + "}\\right)";
+}
+
+// Section 3, last part: the stability constant (eq. 38), its rate and its jump at θo = θR.
+void stability_constant_blocks(doc::Document& out, const CaseDerivation& d) {
+  const CaseParameters& p = d.parameters;
+  const RadicalList& r = d.radicals;
+  const StabilityConstant& sc = d.contact.stability;
+  if (!sc.applicable) {
+    out.push_back(doc::paragraph(doc::text("Stability constant (eq. 38): " + sc.region + ".")));
+    return;
   }
-  // momentum
+  const ex a = (p.Fm + p.FL) / (2 * (p.Jm + p.JL));
+  const Radical* omega = nullptr;
+  for (const Radical& rad : r)
+    if (rad.symbol.get_name() == "omega_c") omega = &rad;
+  out.push_back(doc::paragraph(
+      doc::text("The stability constant (eq. 38), with ") + doc::math("a = F/2J = " + pp::latex(a)) + doc::text(", ") +
+      doc::math("\\omega_c") + doc::text(" as above and ") + doc::math("e = \\theta_R - \\theta_o") + doc::text(":")));
+  out.push_back(doc::equation(
+      "C = \\frac{1}{\\omega_c}\\sqrt{\\dot\\theta_o^{2} - \\frac{F}{J}\\dot\\theta_o e + \\frac{K}{J}e^{2}}\\;"
+      "\\exp\\left(\\frac{a}{\\omega_c}\\arctan\\frac{\\dot\\theta_o - a e}{\\omega_c e}\\right)"));
+  if (omega) out.push_back(doc::equation(stability_constant_numbers(p, *omega)));
+  out.push_back(doc::paragraph(doc::math("d\\ln C/dt = " + pp::latex(sc.dlnC_dt)) +
+                               doc::text(" exactly along every contact trajectory.  Crossing ") + doc::math("\\theta_o = \\theta_R") +
+                               doc::text(" multiplies the principal-branch C by ") +
+                               doc::math("e^{-\\pi a/\\omega_c} = " + pp::latex(with_explicit_radicals(sc.jump_factor, r)) + " \\approx " +
+                                         pp::decimal(to_double(sc.jump_factor, r), 6)) +
+                               doc::text(".  Where it holds: inside each open half-plane ") + doc::math("\\theta_o < \\theta_R") +
+                               doc::text(", ") + doc::math("\\theta_o > \\theta_R") +
+                               doc::text("; C compares a separation point with a recombination point only when both lie in the "
+                                         "same half-plane, or after that factor is applied.")));
+}
+
+}  // namespace
+
+doc::Document derivation_document(const CaseDerivation& d, const EquationTags& tags, int level) {
+  doc::Document out;
+  model_section(out, d.parameters, tags, level);
+  steps_section(out, d, tags, level);
+  // ---- separation line, isoclines, momentum, stability
+  out.push_back(doc::heading(level, doc::text("Separation line, isoclines, momentum balance, stability constant")));
+  separation_line_blocks(out, d, tags);
+  isocline_table(out, d);
   out.push_back(doc::paragraph(doc::text("Recombination is an inelastic impact that conserves momentum, ") +
                                doc::math("(J_m + J_L)\\dot\\theta_o^{+} = J_m\\dot\\theta_m + J_L\\dot\\theta_L") +
                                doc::text("; after a free flight of duration t from the separation line:")));
-  out.push_back(doc::equation(pp::display("\\dot\\theta_o^{+}(t)", pp::time_function_terms(d.free.recombined_velocity, r, pp::latex_exact),
+  out.push_back(doc::equation(pp::display("\\dot\\theta_o^{+}(t)", pp::time_function_terms(d.free.recombined_velocity, d.radicals, pp::latex_exact),
                                           "")));
-  // stability constant
-  const StabilityConstant& sc = d.contact.stability;
-  if (sc.applicable) {
-    const ex a = F / (2 * J);
-    const Radical* omega = nullptr;
-    for (const Radical& rad : r)
-      if (rad.symbol.get_name() == "omega_c") omega = &rad;
-    out.push_back(doc::paragraph(
-        doc::text("The stability constant (eq. 38), with ") + doc::math("a = F/2J = " + pp::latex(a)) + doc::text(", ") +
-        doc::math("\\omega_c") + doc::text(" as above and ") + doc::math("e = \\theta_R - \\theta_o") + doc::text(":")));
-    out.push_back(doc::equation(
-        "C = \\frac{1}{\\omega_c}\\sqrt{\\dot\\theta_o^{2} - \\frac{F}{J}\\dot\\theta_o e + \\frac{K}{J}e^{2}}\\;"
-        "\\exp\\left(\\frac{a}{\\omega_c}\\arctan\\frac{\\dot\\theta_o - a e}{\\omega_c e}\\right)"));
-    if (omega) {
-      const ex w = canonical_sqrt(omega->square);
-      // c·body with the case's numbers: "e^{2}" for 1·e², nothing for 0 (no "1\,e^{2}", no "- 0\,…")
-      const auto times = [](const ex& c, const std::string& body) {
-        return c.is_zero() ? std::string() : (c.is_equal(1) ? body : pp::latex(c) + "\\," + body);
-      };
-      const std::string damping = (F / J).is_zero() ? "" : " - " + times(F / J, "\\dot\\theta_o e");
-      const std::string shift = a.is_zero() ? "" : " - " + times(a, "e");
-      out.push_back(doc::equation("C = " + pp::latex(1 / w) + "\\sqrt{\\dot\\theta_o^{2}" + damping + " + " + times(p.K / J, "e^{2}") +
-                                  "}\\;\\exp\\left(" + pp::latex(a / w) + "\\arctan\\frac{\\dot\\theta_o" + shift + "}{" +
-                                  times(w, "e") + "}\\right)"));
-    }
-    out.push_back(doc::paragraph(doc::math("d\\ln C/dt = " + pp::latex(sc.dlnC_dt)) +
-                                 doc::text(" exactly along every contact trajectory.  Crossing ") + doc::math("\\theta_o = \\theta_R") +
-                                 doc::text(" multiplies the principal-branch C by ") +
-                                 doc::math("e^{-\\pi a/\\omega_c} = " + pp::latex(with_explicit_radicals(sc.jump_factor, r)) + " \\approx " +
-                                           pp::decimal(to_double(sc.jump_factor, r), 6)) +
-                                 doc::text(".  Where it holds: inside each open half-plane ") + doc::math("\\theta_o < \\theta_R") +
-                                 doc::text(", ") + doc::math("\\theta_o > \\theta_R") +
-                                 doc::text("; C compares a separation point with a recombination point only when both lie in the "
-                                           "same half-plane, or after that factor is applied.")));
-  } else {
-    out.push_back(doc::paragraph(doc::text("Stability constant (eq. 38): " + sc.region + ".")));
-  }
-  // all checks
+  stability_constant_blocks(out, d);
   out.push_back(doc::heading(level, doc::text("Every exact check of this derivation")));
-  {
-    std::vector<Rich> items;
-    for (const VerificationCheck& c : d.checks) items.push_back(doc::text(c.passed ? "passed: " : "FAILED: ") + check_rich(c.name));
-    out.push_back(doc::list(items));
-  }
+  out.push_back(checks_list(d.checks, ""));
   return out;
 }
 

@@ -10,6 +10,109 @@ namespace {
 
 numeric factorial_of(unsigned n) { return factorial(numeric(n)); }
 
+// The poles of the denominator (new radicals are added to `known`).  factor() returns its factors in
+// GiNaC's hash order and with either sign: give each a leading coefficient (in s) whose first printed
+// term is positive, and sort them (real poles first, then by value).
+std::vector<Pole> ordered_poles(const ex& denominator, const symbol& s, RadicalList& known) {
+  std::vector<Pole> poles = find_poles(denominator, s, known, "omega", "");
+  for (Pole& p : poles) {
+    const ex lc = p.factor.coeff(s, p.factor.degree(s));
+    if (pretty::text(lc).rfind("-", 0) == 0) p.factor = expand(-p.factor);
+  }
+  struct Keyed {
+    Pole pole;
+    int kind;
+    double value;
+    std::string text;
+  };
+  std::vector<Keyed> keyed;
+  for (const Pole& p : poles) {
+    Keyed k{p, static_cast<int>(p.kind), 0.0, pretty::text(p.center)};
+    try {
+      k.value = to_double(p.center, known);
+    } catch (...) {
+      k.value = 0.0;
+    }
+    keyed.push_back(k);
+  }
+  std::stable_sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
+    if (a.kind != b.kind) return a.kind < b.kind;
+    if (a.value != b.value) return a.value > b.value;
+    return a.text < b.text;
+  });
+  poles.clear();
+  for (const Keyed& k : keyed) poles.push_back(k.pole);
+  return poles;
+}
+
+// Where a pole's residues are taken, each with its partner (the pair's other pole; 0 for a real pole).
+std::vector<std::pair<ex, ex>> pole_locations(const Pole& pole, const symbol& i) {
+  std::vector<std::pair<ex, ex>> locations;  // (p, partner)
+  switch (pole.kind) {
+    case Pole::Kind::Real: locations.push_back({pole.center, 0}); break;
+    case Pole::Kind::RealPair:
+      locations.push_back({pole.center + pole.half_width, pole.center - pole.half_width});
+      locations.push_back({pole.center - pole.half_width, pole.center + pole.half_width});
+      break;
+    case Pole::Kind::ComplexPair:
+      locations.push_back({pole.center + i * pole.half_width, pole.center - i * pole.half_width});
+      break;
+  }
+  return locations;
+}
+
+// What the residues add up, in order: the partial fractions (to compare with the transform) and the time terms.
+struct ResidueSums {
+  std::vector<ExpTerm> terms;
+  ex partial_sum = 0;
+};
+
+// The coefficients A_r = (1/(m−r)!) d^{m−r}/ds^{m−r}[H](p) at one location p of a pole of multiplicity m, where
+// H = N/(rest · leading^m) (÷ (s − partner)^m for a pair); each adds its partial fraction and time terms to `sums`.
+PoleResidues::Location location_residues(const Pole& pole, const ex& p, const ex& partner, const ex& H0, const symbol& s,
+                                         const RadicalList& with_i, ResidueSums& sums) {
+  const symbol& i = imaginary_unit().symbol;
+  const unsigned m = pole.multiplicity;
+  PoleResidues::Location location{p, {}};
+  ex H = H0;
+  if (pole.kind != Pole::Kind::Real) H = H / pow(s - partner, m);
+  std::vector<ex> derivatives{H};
+  for (unsigned j = 1; j < m; ++j) derivatives.push_back(derivatives.back().diff(s));
+  location.coefficients.resize(m);
+  for (unsigned r = 1; r <= m; ++r) {
+    const unsigned j = m - r;
+    const ex A = simplify(derivatives[j].subs(s == p) / factorial_of(j), with_i);
+    location.coefficients[r - 1] = A;
+    const ex time_coefficient = A / factorial_of(r - 1);
+    if (pole.kind == Pole::Kind::ComplexPair) {
+      const ex conjugate_A = A.subs(i == -i), conjugate_p = p.subs(i == -i);
+      sums.partial_sum += A / pow(s - p, r) + conjugate_A / pow(s - conjugate_p, r);
+      const ex real_part = simplify(time_coefficient.subs(i == 0), with_i);
+      const ex imag_part = simplify(time_coefficient.coeff(i, 1), with_i);
+      sums.terms.push_back({2 * real_part, r - 1, pole.center, Oscillation::Cos, pole.half_width});
+      sums.terms.push_back({-2 * imag_part, r - 1, pole.center, Oscillation::Sin, pole.half_width});
+    } else {
+      sums.partial_sum += A / pow(s - p, r);
+      sums.terms.push_back({time_coefficient, r - 1, p, Oscillation::None, 0});
+    }
+  }
+  return location;
+}
+
+// One pole's residues at each of its locations.
+PoleResidues pole_residues(const Pole& pole, const ex& numerator, const ex& denominator, const symbol& s, const RadicalList& with_i,
+                           ResidueSums& sums) {
+  PoleResidues row;
+  row.pole = pole;
+  const unsigned m = pole.multiplicity;
+  const ex factor_power = expand(pow(pole.factor, m));
+  const ex rest = quo(expand(denominator), factor_power, s, false);
+  const ex leading = pole.factor.coeff(s, pole.factor.degree(s));
+  for (const auto& [p, partner] : pole_locations(pole, imaginary_unit().symbol))
+    row.locations.push_back(location_residues(pole, p, partner, numerator / (pow(leading, m) * rest), s, with_i, sums));
+  return row;
+}
+
 }  // namespace
 
 SegmentSteps segment_steps(const Segment& segment, const RadicalList& radicals) {
@@ -19,43 +122,10 @@ SegmentSteps segment_steps(const Segment& segment, const RadicalList& radicals) 
   const ex numerator = steps.transform.numerator, denominator = steps.transform.denominator;
 
   RadicalList known = radicals;
-  std::vector<Pole> poles = find_poles(denominator, s, known, "omega", "");
-  // factor() returns its factors in GiNaC's hash order and with either sign: give each a
-  // leading coefficient (in s) whose first printed term is positive, and sort them (real poles
-  // first, then by value)
-  for (Pole& p : poles) {
-    const ex lc = p.factor.coeff(s, p.factor.degree(s));
-    if (pretty::text(lc).rfind("-", 0) == 0) p.factor = expand(-p.factor);
-  }
-  {
-    struct Keyed {
-      Pole pole;
-      int kind;
-      double value;
-      std::string text;
-    };
-    std::vector<Keyed> keyed;
-    for (const Pole& p : poles) {
-      Keyed k{p, static_cast<int>(p.kind), 0.0, pretty::text(p.center)};
-      try {
-        k.value = to_double(p.center, known);
-      } catch (...) {
-        k.value = 0.0;
-      }
-      keyed.push_back(k);
-    }
-    std::stable_sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
-      if (a.kind != b.kind) return a.kind < b.kind;
-      if (a.value != b.value) return a.value > b.value;
-      return a.text < b.text;
-    });
-    poles.clear();
-    for (const Keyed& k : keyed) poles.push_back(k.pole);
-  }
+  const std::vector<Pole> poles = ordered_poles(denominator, s, known);
   RadicalList with_i = known;
   with_i.push_back(imaginary_unit());
   steps.radicals = known;
-  const symbol& i = imaginary_unit().symbol;
 
   ex product = 1;
   for (const Pole& p : poles) {
@@ -64,56 +134,10 @@ SegmentSteps segment_steps(const Segment& segment, const RadicalList& radicals) 
   }
   steps.leading_constant = normal(denominator / expand(product));
 
-  std::vector<ExpTerm> terms;
-  ex partial_sum = 0;
-  for (const Pole& pole : poles) {
-    PoleResidues row;
-    row.pole = pole;
-    const unsigned m = pole.multiplicity;
-    const ex factor_power = expand(pow(pole.factor, m));
-    const ex rest = quo(expand(denominator), factor_power, s, false);
-    const ex leading = pole.factor.coeff(s, pole.factor.degree(s));
-    std::vector<std::pair<ex, ex>> locations;  // (p, partner)
-    switch (pole.kind) {
-      case Pole::Kind::Real: locations.push_back({pole.center, 0}); break;
-      case Pole::Kind::RealPair:
-        locations.push_back({pole.center + pole.half_width, pole.center - pole.half_width});
-        locations.push_back({pole.center - pole.half_width, pole.center + pole.half_width});
-        break;
-      case Pole::Kind::ComplexPair:
-        locations.push_back({pole.center + i * pole.half_width, pole.center - i * pole.half_width});
-        break;
-    }
-    for (const auto& [p, partner] : locations) {
-      PoleResidues::Location location{p, {}};
-      ex H = numerator / (pow(leading, m) * rest);
-      if (pole.kind != Pole::Kind::Real) H = H / pow(s - partner, m);
-      std::vector<ex> derivatives{H};
-      for (unsigned j = 1; j < m; ++j) derivatives.push_back(derivatives.back().diff(s));
-      location.coefficients.resize(m);
-      for (unsigned r = 1; r <= m; ++r) {
-        const unsigned j = m - r;
-        const ex A = simplify(derivatives[j].subs(s == p) / factorial_of(j), with_i);
-        location.coefficients[r - 1] = A;
-        const ex time_coefficient = A / factorial_of(r - 1);
-        if (pole.kind == Pole::Kind::ComplexPair) {
-          const ex conjugate_A = A.subs(i == -i), conjugate_p = p.subs(i == -i);
-          partial_sum += A / pow(s - p, r) + conjugate_A / pow(s - conjugate_p, r);
-          const ex real_part = simplify(time_coefficient.subs(i == 0), with_i);
-          const ex imag_part = simplify(time_coefficient.coeff(i, 1), with_i);
-          terms.push_back({2 * real_part, r - 1, pole.center, Oscillation::Cos, pole.half_width});
-          terms.push_back({-2 * imag_part, r - 1, pole.center, Oscillation::Sin, pole.half_width});
-        } else {
-          partial_sum += A / pow(s - p, r);
-          terms.push_back({time_coefficient, r - 1, p, Oscillation::None, 0});
-        }
-      }
-      row.locations.push_back(std::move(location));
-    }
-    steps.poles.push_back(std::move(row));
-  }
-  steps.from_residues = TimeFunction(std::move(terms)).combined(known);
-  steps.partial_fractions_sum_to_transform = is_exactly_zero(partial_sum - segment.laplace, with_i);
+  ResidueSums sums;
+  for (const Pole& pole : poles) steps.poles.push_back(pole_residues(pole, numerator, denominator, s, with_i, sums));
+  steps.from_residues = TimeFunction(std::move(sums.terms)).combined(known);
+  steps.partial_fractions_sum_to_transform = is_exactly_zero(sums.partial_sum - segment.laplace, with_i);
   steps.residues_give_solution = (steps.from_residues - segment.solution).is_zero(known);
   return steps;
 }
