@@ -87,7 +87,8 @@ struct Continuation {
   bool first = true;
 };
 
-SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& family, Continuation& c) {
+SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& family, Continuation& c,
+                   const SettleOptions& settle) {
   SweepRow row;
   row.point = point;
   if (c.first || point.series != c.series) c.guess = 0, c.warm.reset();
@@ -127,13 +128,16 @@ SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& fam
       lc.warm_start = c.warm;
       row.cycle = find_limit_cycle(gate.model(), lc);
       if (row.cycle.status == "limit_cycle") c.warm = row.cycle.section_state; else c.warm.reset();
+      if (settle.step != 0) row.settle = settle_time(gate.model(), row.cycle, settle);
     } else {
       LimitCycleOptions lc;
       lc.guess = c.guess;
       row.cycle = find_limit_cycle(*verdict.evaluator, lc);
       c.guess = row.cycle.status == "limit_cycle" ? row.cycle.separation_velocity : 0;
+      if (settle.step != 0) row.settle = settle_time(*verdict.evaluator, row.cycle, settle);
     }
     shift_angles(row.cycle, reference);
+    row.settle.band_low += reference, row.settle.band_high += reference;
     row.status = row.cycle.status;
     row.reason = row.cycle.reason;
   } catch (const std::exception& e) {
@@ -146,31 +150,40 @@ SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& fam
 
 }  // namespace
 
+std::shared_ptr<const ValidatedParametricFamily> sweep_family(long count, const std::function<SweepPoint(long)>& point,
+                                                              const SweepOptions& options) {
+  // Validated at evenly spaced samples (deterministic: before any worker starts).
+  auto family = std::make_shared<ValidatedParametricFamily>();
+  std::vector<Parameters> samples;
+  const long k_count = std::min<long>(count, std::max(2, options.validation_samples));
+  for (long k = 0; k < k_count; ++k) {
+    const long index = k_count == 1 ? 0 : static_cast<long>(static_cast<long double>(k) * (count - 1) / (k_count - 1));
+    Parameters q = point(index).parameters;
+    q.theta_R = 0;
+    if (!parameter_scale_problem(q)) samples.push_back(q);
+  }
+  family->validate_samples(samples);
+  return family;
+}
+
 void run_sweep_streamed(long count, const std::function<SweepPoint(long)>& point, const SweepOptions& options,
                         const std::function<void(const SweepRow&)>& row, SweepSummary* summary) {
   if (count <= 0) return;
-  // The family: validated at evenly spaced samples (deterministic: before any worker starts).
-  ValidatedParametricFamily family;
-  {
-    std::vector<Parameters> samples;
-    const long k_count = std::min<long>(count, std::max(2, options.validation_samples));
-    for (long k = 0; k < k_count; ++k) {
-      const long index = k_count == 1 ? 0 : static_cast<long>(static_cast<long double>(k) * (count - 1) / (k_count - 1));
-      Parameters q = point(index).parameters;
-      q.theta_R = 0;
-      if (!parameter_scale_problem(q)) samples.push_back(q);
-    }
-    family.validate_samples(samples);
-  }
+  const std::shared_ptr<const ValidatedParametricFamily> shared =
+      options.family ? options.family : sweep_family(count, point, options);
+  const ValidatedParametricFamily& family = *shared;
   const long block = std::max(1, options.block);
-  const long blocks = (count + block - 1) / block;
-  const long threads = std::max<long>(1, std::min<long>(options.threads, blocks));
+  const long end = options.last < 0 ? count : std::min(count, options.last);
+  const long first_block = std::max(0L, options.first) / block;
+  const long blocks = (end + block - 1) / block;
+  if (first_block >= blocks) return;
+  const long threads = std::max<long>(1, std::min<long>(options.threads, blocks - first_block));
   const long window = 4 * threads;  // blocks computed ahead of the one being delivered
 
   std::mutex mutex;
   std::condition_variable changed;
   std::map<long, std::vector<SweepRow>> finished;
-  long next_block = 0, next_delivery = 0;
+  long next_block = first_block, next_delivery = first_block;
   bool stopping = false;
   std::exception_ptr failure;
   std::atomic<long> done{0};
@@ -188,12 +201,12 @@ void run_sweep_streamed(long count, const std::function<SweepPoint(long)>& point
         }
         std::vector<SweepRow> rows;
         Continuation continuation;
-        for (long i = b * block; i < std::min(count, (b + 1) * block); ++i) {
-          rows.push_back(sweep_row(point(i), family, continuation));
+        for (long i = b * block; i < std::min(end, (b + 1) * block); ++i) {
+          rows.push_back(sweep_row(point(i), family, continuation, options.settle));
           const long finished_points = ++done;
           if (options.progress) {
             std::lock_guard<std::mutex> lock(progress_mutex);
-            options.progress(finished_points, count);
+            options.progress(finished_points, end - first_block * block);
           }
         }
         std::lock_guard<std::mutex> lock(mutex);
