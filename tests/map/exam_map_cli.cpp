@@ -128,12 +128,12 @@ TEST(MapCli, check_files_do_not_depend_on_the_number_of_mpi_ranks) {
 #endif
 
 TEST(MapCli, exam_a_signal_stops_the_map_and_resume_finishes_it_to_the_same_bytes) {
-  const std::string big = "map V --vary JL_over_Jm=0.5:2:8 --vary FL_over_F=0.1:0.9:64 --no-figures --block 8 --threads 1";
-  const CliRun whole = run(big + " --out " + (scratch() / "whole").string());
+  const std::string big = "map V --vary JL_over_Jm=0.5:2:8 --vary FL_over_F=0.1:0.9:64 --no-figures --block 8";
+  const CliRun whole = run(big + " --threads 1 --out " + (scratch() / "whole").string());
   ASSERT_EQ(whole.exit_code, 0) << whole.err;
   const fs::path out = scratch() / "stopped", checkpoint = scratch() / ".stopped.map-partial" / "checkpoint";
   const fs::path o = scratch() / "stopped.out", e = scratch() / "stopped.err";
-  const pid_t child = start(std::string(BACKLASH_CLI) + " " + big + " --out " + out.string() + " > " + o.string() + " 2> " +
+  const pid_t child = start(std::string(BACKLASH_CLI) + " " + big + " --threads 1 --out " + out.string() + " > " + o.string() + " 2> " +
                             e.string());
   // Wait until some block is done (the checkpoint says "done N" with N > 0), then SIGTERM.
   for (int k = 0; k < 6000; ++k) {

@@ -103,12 +103,14 @@ TEST(MapKnownAnswers, exam_thesis_case_V_is_a_grid_point) {
 }
 
 TEST(MapKnownAnswers, exam_sobol_points_are_boost_s_sequence) {
-  api::MapRequest r = request({"K=0:1:1", "backlash=0:1:1"});
+  api::MapRequest r = request({"K=1:2:1", "backlash=0:1:1"});
   r.sample = "sobol";
   r.points = 4;
   const api::MapPlan plan(r);
-  // Boost's Sobol sequence skips the zero point: (1/2, 1/2), (3/4, 1/4), (1/4, 3/4), (3/8, 5/8).
-  const std::vector<std::vector<double>> expected = {{0.5, 0.5}, {0.75, 0.25}, {0.25, 0.75}, {0.375, 0.625}};
+  // Boost's Sobol sequence skips the zero point: (1/2, 1/2), (3/4, 1/4), (1/4, 3/4), (3/8, 3/8) (the Joe–Kuo
+  // sequence, as SciPy's unscrambled qmc.Sobol prints it after its zero point).
+  // K = 1 + u: exact in binary.
+  const std::vector<std::vector<double>> expected = {{1.5, 0.5}, {1.75, 0.25}, {1.25, 0.75}, {1.375, 0.375}};
   for (long i = 0; i < 4; ++i)
     EXPECT_EQ(plan.values(i), expected[static_cast<std::size_t>(i)])
         << "point " << i << ": returned (" << plan.values(i)[0] << ", " << plan.values(i)[1] << ")";
