@@ -83,6 +83,72 @@ std::string figure_csv(const Plot& plot) {
   return out.str();
 }
 
+namespace {
+
+// The inline data blocks of figure f: $d<f>_<i> per series (a blank line where a point is
+// not finite: a break in the line) and $h<f> for the heat map (x y xlow xhigh ylow yhigh value).
+void write_data_blocks(std::ostringstream& script, const Plot& plot, std::size_t f) {
+  for (std::size_t i = 0; i < plot.series.size(); ++i) {
+    const Series& s = plot.series[i];
+    script << "$d" << f << "_" << i << " << EOD\n";
+    for (std::size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
+      if (!std::isfinite(s.x[k]) || !std::isfinite(s.y[k])) script << "\n";
+      else script << number(s.x[k]) << " " << number(s.y[k]) << "\n";
+    }
+    script << "EOD\n";
+  }
+  if (!plot.heat_map) return;
+  const HeatMap& h = *plot.heat_map;
+  script << "$h" << f << " << EOD\n";
+  for (std::size_t k = 0; k < h.value.size() && k < h.x_low.size() && k < h.x_high.size() && k < h.y_low.size() && k < h.y_high.size(); ++k) {
+    if (!std::isfinite(h.value[k])) continue;
+    const double xc = plot.x_log ? std::sqrt(h.x_low[k] * h.x_high[k]) : (h.x_low[k] + h.x_high[k]) / 2;
+    const double yc = plot.y_log ? std::sqrt(h.y_low[k] * h.y_high[k]) : (h.y_low[k] + h.y_high[k]) / 2;
+    script << number(xc) << " " << number(yc) << " " << number(h.x_low[k]) << " " << number(h.x_high[k]) << " "
+           << number(h.y_low[k]) << " " << number(h.y_high[k]) << " " << number(h.value[k]) << "\n";
+  }
+  script << "EOD\n";
+}
+
+// The settings a heat map and log axes add (none for a plain plot: its script is unchanged).
+void write_heat_map_settings(std::ostringstream& body, const Plot& plot) {
+  if (plot.x_log) body << "set logscale x\n";
+  if (plot.y_log) body << "set logscale y\n";
+  if (!plot.heat_map) return;
+  // a perceptually uniform palette (viridis's end and middle colours), readable in grey
+  body << "set palette defined (0 '#440154', 1 '#3b528b', 2 '#21918c', 3 '#5ec962', 4 '#fde725')\n"
+       << "set cblabel " << quoted(plot.heat_map->colour_label) << "\nset colorbox\n";
+}
+
+// The gnuplot commands that draw figure f (the same for the SVG and the PDF).
+std::string figure_body(const Plot& plot, std::size_t f) {
+  std::ostringstream body;
+  body << "reset\nset encoding utf8\n"
+       << "set title " << quoted(plot.title) << "\n"
+       << "set xlabel " << quoted(plot.x_label) << "\nset ylabel " << quoted(plot.y_label) << "\n"
+       << "set grid lc rgb '#dddddd'\nset key " << plot.key << " spacing 1.1\n"
+       << "set border lw 1\nset tics nomirror\nset xtics mirror\nset ytics mirror\n";
+  write_heat_map_settings(body, plot);
+  if (plot.x_range) body << "set xrange [" << number(plot.x_range->first) << ":" << number(plot.x_range->second) << "]\n";
+  if (plot.y_range) body << "set yrange [" << number(plot.y_range->first) << ":" << number(plot.y_range->second) << "]\n";
+  for (std::size_t l = 0; l < plot.labels.size(); ++l)
+    body << "set label " << (l + 1) << " " << quoted(plot.labels[l].text) << " at " << number(plot.labels[l].x) << ","
+         << number(plot.labels[l].y) << " font ',9' tc rgb '#555555'\n";
+  body << "plot ";
+  if (plot.heat_map)
+    body << "$h" << f << " using 1:2:3:4:5:6:7 with boxxyerror fs solid 1.0 noborder lc palette notitle"
+         << (plot.series.empty() ? "" : ", \\\n     ");
+  for (std::size_t i = 0; i < plot.series.size(); ++i) {
+    const Series& s = plot.series[i];
+    body << (i ? ", \\\n     " : "") << "$d" << f << "_" << i << " using 1:2 with " << s.style
+         << (s.in_key ? " title " + quoted(s.label) : std::string(" notitle"));
+  }
+  body << "\n";
+  return body.str();
+}
+
+}  // namespace
+
 std::optional<std::string> render_figures(const std::vector<Plot>& plots, const std::filesystem::path& directory) {
   namespace fs = std::filesystem;
   if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) return std::string("gnuplot is not installed");
@@ -90,41 +156,16 @@ std::optional<std::string> render_figures(const std::vector<Plot>& plots, const 
   script << "set encoding utf8\n";
   for (std::size_t f = 0; f < plots.size(); ++f) {
     const Plot& plot = plots[f];
-    for (std::size_t i = 0; i < plot.series.size(); ++i) {
-      const Series& s = plot.series[i];
-      script << "$d" << f << "_" << i << " << EOD\n";
-      for (std::size_t k = 0; k < s.x.size() && k < s.y.size(); ++k) {
-        if (!std::isfinite(s.x[k]) || !std::isfinite(s.y[k])) script << "\n";
-        else script << number(s.x[k]) << " " << number(s.y[k]) << "\n";
-      }
-      script << "EOD\n";
-    }
-    std::ostringstream body;
-    body << "reset\nset encoding utf8\n"
-         << "set title " << quoted(plot.title) << "\n"
-         << "set xlabel " << quoted(plot.x_label) << "\nset ylabel " << quoted(plot.y_label) << "\n"
-         << "set grid lc rgb '#dddddd'\nset key " << plot.key << " spacing 1.1\n"
-         << "set border lw 1\nset tics nomirror\nset xtics mirror\nset ytics mirror\n";
-    if (plot.x_range) body << "set xrange [" << number(plot.x_range->first) << ":" << number(plot.x_range->second) << "]\n";
-    if (plot.y_range) body << "set yrange [" << number(plot.y_range->first) << ":" << number(plot.y_range->second) << "]\n";
-    for (std::size_t l = 0; l < plot.labels.size(); ++l)
-      body << "set label " << (l + 1) << " " << quoted(plot.labels[l].text) << " at " << number(plot.labels[l].x) << ","
-           << number(plot.labels[l].y) << " font ',9' tc rgb '#555555'\n";
-    body << "plot ";
-    for (std::size_t i = 0; i < plot.series.size(); ++i) {
-      const Series& s = plot.series[i];
-      body << (i ? ", \\\n     " : "") << "$d" << f << "_" << i << " using 1:2 with " << s.style
-           << (s.in_key ? " title " + quoted(s.label) : std::string(" notitle"));
-    }
-    body << "\n";
+    write_data_blocks(script, plot, f);
+    const std::string body = figure_body(plot, f);
     const fs::path stem = fs::path("figures") / plot.name;
     script << "set terminal svg size " << plot.width << "," << plot.height << " enhanced font 'DejaVu Sans,12' background '#ffffff'\n"
            << "set output " << quoted(stem.string() + ".svg", true) << "\n"
-           << body.str() << "set output\n";
+           << body << "set output\n";
     script << "set terminal pdfcairo size " << number(plot.width / 130.0) << "in," << number(plot.height / 130.0)
            << "in enhanced font 'DejaVu Sans,8.5' background '#ffffff'\n"
            << "set output " << quoted(stem.string() + ".pdf", true) << "\n"
-           << body.str() << "set output\n";
+           << body << "set output\n";
   }
   const fs::path script_file = directory / "figures.gp";
   {

@@ -10,18 +10,24 @@
 // MapFigures accumulates the points as they stream past, in point order, into fixed bins
 // per pair of varied parameters (memory flat in the number of points), and then writes:
 //   - for every pair (p, q) of varied parameters, a heat map of the mean peak-to-peak over
-//     the bins (points without a cycle count as 0 in it), with the cycle/no-cycle boundary
-//     drawn as the 1/2-contour of the fraction of points with a cycle, and the exact
-//     boundary crossings (add_boundary) overlaid as markers: figures/map_P_Q.svg (+ .pdf);
+//     the bins (points without a cycle, status "none", count as 0 in it; points whose
+//     answer is unknown — divergent, unvalidated, refused, error — are counted per status
+//     but left out of the bins), with the cycle/no-cycle boundary drawn as the 1/2-contour
+//     of the fraction of points with a cycle (marching squares through the bin centres),
+//     and the exact boundary crossings (add_boundary) along p or q overlaid as markers:
+//     figures/map_P_Q.svg (+ .pdf);
 //   - summary.md: the counts per status, the range of the magnitude, and a sensitivity
 //     ranking of the varied parameters (which moves the magnitude most: the first-order
 //     index Var(E[magnitude | parameter]) / Var(magnitude), estimated from the bins of each
 //     parameter), each figure linked.
-// Same points in the same order give the same bytes.
+// Bins: a grid axis has one bin per grid value (consecutive values share a bin beyond
+// max_bins_per_axis); a sampled axis has `bins` equal bins, in log10 of the value when
+// log_scale.  Same points in the same order give the same bytes.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -56,19 +62,47 @@ struct MapBoundaryPoint {
 struct MapSensitivity {
   std::string name;
   double first_order_index = 0;  ///< Var(E[magnitude | parameter]) / Var(magnitude), in [0, 1]
+  /// The index's expected excess from the sampling noise of the bin means (sampled maps):
+  /// (B − 1)·MS_within / SS_total for B non-empty bins — about (B − 1)/N of the variance
+  /// the parameter does not explain; 0 for a full grid, where the bin means are exact.
+  double bias = 0;
+};
+
+/// What the heat map of the pair (p, q), p < q, draws (MapFigures::field).
+struct MapField {
+  int p = 0, q = 0;
+  std::vector<double> x_edges, y_edges;      ///< nx + 1 and ny + 1 bin edges (values of p, of q)
+  std::vector<std::int64_t> count;           ///< points per bin (decided ones), index ix + nx·iy
+  std::vector<double> mean_peak_to_peak;     ///< rad, 0 for "none"; NaN in an empty bin
+  std::vector<double> cycle_fraction;        ///< fraction of the bin's points with a cycle; NaN if empty
+  std::vector<double> contour_x, contour_y;  ///< the 1/2-contour of cycle_fraction; NaN between pieces
+  std::vector<double> boundary_x, boundary_y;  ///< exact crossings along p or q (at most max_boundary_markers)
 };
 
 class MapFigures {
  public:
-  /// `sampling` is "grid", "sobol" or "lhs"; `case_id` names the case in titles.
+  static constexpr int max_bins_per_axis = 200;        ///< beyond it, grid values share bins
+  static constexpr int max_boundary_markers = 4096;    ///< per pair; thinned evenly, in order
+  /// `sampling` is "grid", "sobol" or "lhs"; `case_id` names the case in titles.  Throws
+  /// std::invalid_argument (one line naming the axis and field) for an unknown sampling, a
+  /// non-finite bound, from = to (except a grid of one value), bins < 1, or a log axis
+  /// that reaches 0 or below.  from > to is read as the same box.
   MapFigures(std::string case_id, std::vector<MapAxis> axes, std::string sampling);
 
-  /// Adds a point; points must come in index order (the output does not depend on threads).
+  /// Adds a point; points must come in increasing index order (the output does not depend
+  /// on threads).  Throws std::invalid_argument, naming the point and the parameter, for
+  /// an index that does not increase, a value count other than the axes', or a value
+  /// outside its axis's box (or, on a grid, off its grid values).
   void add(const MapPoint& point);
+  /// Adds an exact crossing; it marks the pair figures of (along, other axis).  Throws
+  /// std::invalid_argument for a value count other than the axes' or `along` out of range.
   void add_boundary(const MapBoundaryPoint& point);
 
-  std::vector<MapSensitivity> sensitivities() const;  ///< ranked, largest first
+  std::vector<MapSensitivity> sensitivities() const;  ///< ranked, largest first (ties: axis order)
   std::string summary_markdown() const;
+  MapField field(int p, int q) const;  ///< p < q, axis indices; std::out_of_range otherwise
+  /// "figures/map_P_Q" for the pair (p, q): the stem of its SVG and PDF under write()'s directory.
+  std::string figure_stem(int p, int q) const;
 
   /// Writes figures/map_P_Q.svg (+ .pdf when gnuplot can) for every pair and summary.md
   /// into `directory` (which exists).  Returns the reason when figures could not be drawn
@@ -76,19 +110,35 @@ class MapFigures {
   std::string write(const std::filesystem::path& directory) const;
 
  private:
-  struct Accumulators;
+  /// Count, count with a cycle, mean and sum of squared deviations of the magnitude
+  /// (Welford's update: stable for any number of points).
+  struct Bin {
+    std::int64_t n = 0, cycles = 0;
+    double mean = 0, m2 = 0;
+    void add(double magnitude, bool cycle);
+  };
+  /// Boundary markers of one pair, thinned to at most max_boundary_markers: every
+  /// stride-th crossing is kept, the stride doubling whenever the list is full.
+  struct Markers {
+    std::vector<std::pair<double, double>> kept;
+    std::int64_t seen = 0, stride = 1;
+  };
+  int bin_of(std::size_t axis, double x, std::int64_t index) const;
+  std::vector<double> edges(std::size_t axis) const;
+  std::size_t pair_slot(int p, int q) const;
+
   std::string case_id_;
   std::vector<MapAxis> axes_;
   std::string sampling_;
-  std::vector<MapBoundaryPoint> boundary_;
-  // per-pair and per-axis bins (count, count with a cycle, sum and sum of squares of the magnitude)
-  struct Bin { std::int64_t n = 0, cycles = 0; double sum = 0, sum_sq = 0; };
-  std::vector<std::vector<Bin>> pair_bins_;  ///< pair (p<q) in lexicographic order, bins row-major
+  std::vector<int> bins_, group_;             ///< bins per axis; grid values per bin (grid)
+  std::vector<std::vector<Bin>> pair_bins_;   ///< pair (p<q) in lexicographic order, bins ix + nx·iy
   std::vector<std::vector<Bin>> axis_bins_;
-  std::int64_t points_ = 0;
+  std::vector<Markers> markers_;              ///< per pair
+  Bin all_;
+  std::int64_t points_ = 0, last_index_ = -1, boundary_points_ = 0, periods_ = 0;
+  std::vector<std::string> status_names_;     ///< the six known statuses, then others as met
   std::vector<std::int64_t> status_counts_;
-  std::vector<std::string> status_names_;
-  double magnitude_min_ = 0, magnitude_max_ = 0;
+  double magnitude_min_ = 0, magnitude_max_ = 0, period_min_ = 0, period_max_ = 0;
 };
 
 }  // namespace backlash::reports

@@ -1,7 +1,8 @@
 // backlash/reports/plot.hpp — figures for the reports, drawn by gnuplot.
 //
 // A Plot is a list of series (x, y columns; a NaN breaks a line) with labels,
-// axis titles (with units) and a legend.  render_figures() writes one gnuplot
+// axis titles (with units) and a legend, optionally over a heat map (filled cells
+// coloured by a value, with a colour bar) and on logarithmic axes.  render_figures() writes one gnuplot
 // script with every figure as inline data blocks and runs gnuplot once in the
 // output folder: figures/NAME.svg (for the web pages) and figures/NAME.pdf (vector,
 // for report.pdf; cairo's time stamp is replaced by the epoch, so the bytes are
@@ -31,6 +32,14 @@ struct Label {
   double x = 0, y = 0;
 };
 
+/// A heat map drawn under the series: one filled cell [x_low, x_high] × [y_low, y_high]
+/// per entry, coloured by `value` (a NaN value leaves its cell blank), with a colour bar
+/// titled `colour_label` (with units).  The cells need not be uniform (log axes).
+struct HeatMap {
+  std::vector<double> x_low, x_high, y_low, y_high, value;
+  std::string colour_label;
+};
+
 struct Plot {
   std::string name;                ///< file stem under figures/, e.g. "fig21_case_V_phase_plane"
   std::string title;               ///< names the thesis figure
@@ -40,6 +49,8 @@ struct Plot {
   std::optional<std::pair<double, double>> x_range, y_range;
   std::string key = "outside right top";
   int width = 1000, height = 650;  ///< SVG size in pixels; the PDF is drawn at 130 px per inch
+  std::optional<HeatMap> heat_map;  ///< drawn first, under the series
+  bool x_log = false, y_log = false;  ///< logarithmic axes
 };
 
 /// Draws every plot into `directory`/figures (NAME.svg, NAME.pdf).  Returns the reason
