@@ -413,7 +413,12 @@ void bind_map(py::module_& m) {
         api::MapOutput o;
         o.out = out;
         o.resume = resume;
-        const api::MapSummary s = api::write_map(request_of(target, vary, sample, points, threads, step), o);
+        const api::MapRequest r = request_of(target, vary, sample, points, threads, step);
+        api::MapSummary s;
+        {
+          py::gil_scoped_release release;
+          s = api::write_map(r, o);
+        }
         py::dict d;
         d["points"] = s.points;
         d["resumed_from"] = s.resumed_from;
@@ -422,7 +427,7 @@ void bind_map(py::module_& m) {
         return d;
       },
       py::arg("target"), py::arg("vary"), py::arg("sample"), py::arg("points"), py::arg("threads"), py::arg("step"),
-      py::arg("out"), py::arg("resume"), Release());
+      py::arg("out"), py::arg("resume"));
 }
 
 // records, discrepancy
