@@ -80,8 +80,9 @@ void run(const MapFlags& f) {
   if (transport && transport->rank() != 0) return;
   const int ranks = transport ? transport->size() : 1;
   if (!s.complete)
-    throw std::runtime_error("map: interrupted after " + std::to_string(s.resumed_from + s.written) + " of " +
-                             std::to_string(s.points) + " points; run the same command with --resume to finish");
+    throw std::runtime_error("map: interrupted; " + std::to_string(s.kept) + " of " + std::to_string(s.points) +
+                             " points kept in " + api::map_partial_folder(f.out).string() +
+                             "; run the same command with --resume to finish");
   std::cerr << "map: " << s.points << " points (" << s.points - s.resumed_from << " computed by this run) on "
             << f.threads << " threads x " << ranks << " ranks; " << s.boundary_points << " boundary points; "
             << f.out << (s.figures_note.empty() ? "" : "; " + s.figures_note) << "\n";

@@ -191,7 +191,10 @@ void commit(const fs::path& staging, const fs::path& target) {
   fs::path old;
   if (fs::exists(fs::symlink_status(clean, error))) {
     check_target(clean);  // still empty or a backlash output
-    old = clean.parent_path() / ("." + clean.filename().string() + ".map-old");
+    std::string name = ".";  // (built step by step: GCC 12 warns falsely on "." + string)
+    name += clean.filename().string();
+    name += ".map-old";
+    old = clean.parent_path() / name;
     fs::remove_all(old, error);
     fs::rename(clean, old);
   }

@@ -33,7 +33,10 @@ std::string fingerprint(const MapPlan& plan, const MapOutput& output) {
 fs::path staging_path(const fs::path& target) {
   const fs::path absolute = fs::absolute(target).lexically_normal();
   const fs::path clean = absolute.has_filename() ? absolute : absolute.parent_path();
-  return clean.parent_path() / ("." + clean.filename().string() + ".map-partial");
+  std::string name = ".";  // (built step by step: GCC 12 warns falsely on "." + string)
+  name += clean.filename().string();
+  name += ".map-partial";
+  return clean.parent_path() / name;
 }
 
 // The rules of reports/output_directory.hpp: a new folder, an empty one, or a report's.
@@ -214,6 +217,8 @@ bool compute_distributed(const MapPlan& plan, const numeric::SweepOptions& optio
 
 }  // namespace
 
+std::filesystem::path map_partial_folder(const std::filesystem::path& out) { return detail::staging_path(out); }
+
 MapSummary write_map(const MapRequest& request, const MapOutput& output) {
   const MapPlan plan(request);
   MapTransport* t = output.transport;
@@ -247,7 +252,7 @@ MapSummary write_map(const MapRequest& request, const MapOutput& output) {
       complete = false;
     }
   }
-  if (root) summary.written = writer->written(), writer->close();
+  if (root) summary.written = writer->written(), summary.kept = writer->done(), writer->close();
   summary.complete = complete;
   if (!complete) return summary;
   detail::finish_map(plan, output, options.family, summary);

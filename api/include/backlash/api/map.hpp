@@ -166,6 +166,7 @@ struct MapOutput {
 struct MapSummary {
   long points = 0, written = 0;  ///< the map's points; rows written by this run (resume: the rest)
   long resumed_from = 0;         ///< the first point computed by this run
+  long kept = 0;                 ///< interrupted: the points of complete blocks kept for --resume
   long boundary_points = 0;
   bool complete = false;         ///< false: interrupted, the partial folder kept for --resume
   std::string figures_note;      ///< why figures were not drawn (empty: drawn)
@@ -178,5 +179,7 @@ struct MapSummary {
 /// recomputed) and the final files are byte-identical to an uninterrupted run's.  Every rank of a
 /// transport calls it; rank 0 writes.  BadInput for a bad request or --out, before anything is written.
 MapSummary write_map(const MapRequest& request, const MapOutput& output);
+/// Where write_map keeps an unfinished map of --out `out`: ".OUT.map-partial" beside it.
+std::filesystem::path map_partial_folder(const std::filesystem::path& out);
 
 }  // namespace backlash::api
