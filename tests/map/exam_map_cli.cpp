@@ -78,8 +78,11 @@ CliRun run(const std::string& arguments, const std::string& prefix = "") {
 }
 
 const char* files[] = {"points.csv", "boundary.csv", "map.h5", "map.json"};
+const char* figures[] = {"summary.md", "figures/map_JL_over_Jm_FL_over_F.svg"};
 
 void expect_same_folders(const fs::path& a, const fs::path& b) {
+  for (const char* f : figures)  // drawn when the build has the figures (and gnuplot)
+    if (fs::exists(a / f)) EXPECT_EQ(slurp(a / f), slurp(b / f)) << f << ": " << b << " returned other bytes than " << a;
   for (const char* f : files) {
     ASSERT_TRUE(fs::exists(a / f)) << (a / f);
     EXPECT_EQ(slurp(a / f), slurp(b / f)) << f << ": " << b << " returned other bytes than " << a;
@@ -115,9 +118,10 @@ TEST(MapCli, check_files_do_not_depend_on_the_thread_count) {
 #ifdef BACKLASH_MPIRUN
 TEST(MapCli, check_files_do_not_depend_on_the_number_of_mpi_ranks) {
   const std::string mpirun = std::string(BACKLASH_MPIRUN) + " " + BACKLASH_MPIRUN_FLAGS;
-  const CliRun serial = run(grid + " --threads 1 --out " + (scratch() / "r0").string());
-  const CliRun one = run(grid + " --threads 1 --out " + (scratch() / "r1").string(), mpirun + " -n 1 ");
-  const CliRun two = run(grid + " --threads 1 --out " + (scratch() / "r2").string(), mpirun + " -n 2 ");
+  const std::string with_figures = grid.substr(0, grid.find(" --no-figures"));
+  const CliRun serial = run(with_figures + " --threads 1 --out " + (scratch() / "r0").string());
+  const CliRun one = run(with_figures + " --threads 1 --out " + (scratch() / "r1").string(), mpirun + " -n 1 ");
+  const CliRun two = run(with_figures + " --threads 2 --out " + (scratch() / "r2").string(), mpirun + " -n 2 ");
   ASSERT_EQ(serial.exit_code, 0) << serial.err;
   ASSERT_EQ(one.exit_code, 0) << one.err;
   ASSERT_EQ(two.exit_code, 0) << two.err;

@@ -239,6 +239,17 @@ TEST(MapBadInput, exam_bad_requests_name_their_argument) {
             }),
             "out");
   EXPECT_FALSE(fs::exists(scratch() / "missing-folder"));
+  // --resume of another request: refused, the partial folder of the first left as it was.
+  api::MapOutput o;
+  o.out = scratch() / "other";
+  o.stop_after = 3;
+  EXPECT_FALSE(api::write_map(request({"K=1:2:9"}), o).complete);
+  const std::string checkpoint = slurp(api::map_partial_folder(o.out) / "checkpoint");
+  o.stop_after = -1;
+  o.resume = true;
+  EXPECT_EQ(argument([&] { api::write_map(request({"K=1:2:10"}), o); }), "resume");
+  EXPECT_EQ(slurp(api::map_partial_folder(o.out) / "checkpoint"), checkpoint);
+  EXPECT_FALSE(fs::exists(o.out));
 }
 
 }  // namespace
