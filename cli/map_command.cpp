@@ -15,6 +15,8 @@
 #include "backlash/api/map_mpi.hpp"
 #endif
 
+#include <nlohmann/json.hpp>
+
 #include <csignal>
 #include <iostream>
 
@@ -86,9 +88,15 @@ void run(const MapFlags& f) {
   std::cerr << "map: " << s.points << " points (" << s.points - s.resumed_from << " computed by this run) on "
             << f.threads << " threads x " << ranks << " ranks; " << s.boundary_points << " boundary points; "
             << f.out << (s.figures_note.empty() ? "" : "; " + s.figures_note) << "\n";
-  if (f.json)
-    std::cout << "{\"points\": " << s.points << ", \"resumed_from\": " << s.resumed_from
-              << ", \"boundary_points\": " << s.boundary_points << ", \"out\": \"" << f.out << "\"}\n";
+  if (f.json) {
+    nlohmann::ordered_json j;
+    j["points"] = s.points;
+    j["resumed_from"] = s.resumed_from;
+    j["boundary_points"] = s.boundary_points;
+    j["out"] = f.out;
+    if (!s.figures_note.empty()) j["figures_note"] = s.figures_note;
+    std::cout << j.dump(2) << "\n";
+  }
 }
 
 }  // namespace
@@ -104,7 +112,7 @@ void register_map_command(CLI::App& app) {
   map->add_option("--step", flags->step, "the step A [rad] for the settle time (default: the case's)");
   map->add_option("--out", flags->out, "the output folder (default: the CSV on stdout)");
   map->add_flag("--resume", flags->resume, "continue an interrupted map into the same --out");
-  map->add_flag("--json", flags->json, "print a JSON summary on stdout");
+  map->add_flag("--json", flags->json, "with --out: print a JSON summary on stdout");
   map->add_flag("--no-boundary", flags->no_boundary, "do not solve the cycle/no-cycle boundary");
   map->add_flag("--no-hdf5", flags->no_hdf5, "do not write map.h5");
   map->add_flag("--no-figures", flags->no_figures, "do not draw figures/ and summary.md");
