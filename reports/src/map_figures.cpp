@@ -1,6 +1,7 @@
 // Figures and summary of a design-space map (reports/map_figures.hpp): bins per pair and
 // per axis filled as the points stream past, heat maps with the 1/2-contour of the cycle
-// fraction (marching squares) drawn by gnuplot through plot.hpp, and summary.md.
+// fraction (marching squares) drawn by gnuplot through plot.hpp, and summary.md
+// (docs/map-figures.md).
 #include "backlash/reports/map_figures.hpp"
 
 #include "backlash/reports/plot.hpp"
@@ -443,7 +444,14 @@ Plot pair_plot(const MapField& f, const MapAxis& x, const MapAxis& y, const std:
     h.y_high.push_back(f.y_edges[k / nx + 1]);
     h.value.push_back(f.mean_peak_to_peak[k]);
   }
+  // the colour bar starts at 0 (no cycle); without any cycle it spans [0, 1] rad
+  double top = 0;
+  for (double v : h.value) top = std::isfinite(v) ? std::max(top, v) : top;
+  h.value_range = std::pair{0.0, top > 0 ? top : 1.0};
   plot.heat_map = std::move(h);
+  const bool decided = std::any_of(f.count.begin(), f.count.end(), [](std::int64_t n) { return n > 0; });
+  if (!decided) plot.title += " — no point with a known answer";
+  else if (f.contour_x.empty()) plot.title += " — no cycle/no-cycle boundary inside";
   if (!f.contour_x.empty())
     plot.series.push_back({"cycle/no-cycle boundary: half of the bin's points have a cycle", f.contour_x, f.contour_y,
                            "lines lw 3 lc rgb '#ff2d2d'"});

@@ -118,6 +118,7 @@ void write_heat_map_settings(std::ostringstream& body, const Plot& plot) {
   // a perceptually uniform palette (viridis's end and middle colours), readable in grey
   body << "set palette defined (0 '#440154', 1 '#3b528b', 2 '#21918c', 3 '#5ec962', 4 '#fde725')\n"
        << "set cblabel " << quoted(plot.heat_map->colour_label) << "\nset colorbox\n";
+  if (const auto& r = plot.heat_map->value_range) body << "set cbrange [" << number(r->first) << ":" << number(r->second) << "]\n";
 }
 
 // The gnuplot commands that draw figure f (the same for the SVG and the PDF).

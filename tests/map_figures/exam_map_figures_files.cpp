@@ -160,6 +160,32 @@ TEST(MapFiguresFiles, WithoutGnuplotTheSummarySaysWhy) {
   fs::remove_all(dir);
 }
 
+// A map without a single known answer, or without a boundary, still draws (gnuplot is given
+// no empty colour range) and says so in the title.
+TEST(MapFiguresFiles, MapsWithoutAnswersOrWithoutABoundaryStillDraw) {
+  for (const std::string status : {"error", "limit_cycle"}) {
+    const fs::path dir = fresh_folder("uniform_" + status);
+    MapFigures map("V", {{"K", 1, 2, 3}, {"backlash", 0.1, 0.3, 3}}, "grid");
+    std::int64_t index = 0;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) {
+        backlash::reports::MapPoint p = backlash::test::cycle_point(index++, {1 + a / 2.0, 0.1 + b / 10.0}, 0.02);
+        p.status = status;
+        map.add(p);
+      }
+    const std::string failure = map.write(dir);
+    EXPECT_EQ(failure, "") << status << ": returned \"" << failure << "\" instead of drawing";
+    const std::string text = visible_text(read(dir / "figures" / "map_K_backlash.svg"));
+    const std::string says = status == "error" ? "no point with a known answer" : "no cycle/no-cycle boundary inside";
+    EXPECT_NE(text.find(says), std::string::npos) << status << ": the title does not say \"" << says << "\": " << text;
+    const std::string md = read(dir / "summary.md");
+    if (status == "error") {
+      EXPECT_NE(md.find("No point has a limit cycle."), std::string::npos) << md;
+    }
+    fs::remove_all(dir);
+  }
+}
+
 std::string refusal(const std::function<void()>& action) {
   try {
     action();

@@ -24,6 +24,8 @@ using backlash::reports::MapFigures;
 using backlash::reports::MapSensitivity;
 using std::numbers::pi;
 
+const char* const kNames[] = {"x1", "x2", "x3"};
+
 double index_of(const std::vector<MapSensitivity>& ranked, const std::string& name) {
   for (const MapSensitivity& s : ranked)
     if (s.name == name) return s.first_order_index;
@@ -60,7 +62,7 @@ TEST(MapSensitivity, AdditiveFunctionOnAGridIsExact) {
   EXPECT_EQ(ranked[1].name, "x2");
   EXPECT_EQ(ranked[2].name, "x1");
   for (std::size_t i = 0; i < n.size(); ++i) {
-    const std::string name = "x" + std::to_string(i + 1);
+    const std::string name = kNames[i];
     const double expected = part[i] / total;
     EXPECT_NEAR(index_of(ranked, name), expected, 1e-12)
         << name << ": returned " << index_of(ranked, name) << " instead of " << expected;
@@ -110,7 +112,7 @@ TEST(MapSensitivity, IshigamiFromSampledPointsMatchesItsKnownIndices) {
   EXPECT_NEAR(exact[0], 0.3139, 5e-5);
   EXPECT_NEAR(exact[1], 0.4424, 5e-5);
   for (int i = 0; i < 3; ++i) {
-    const std::string name = "x" + std::to_string(i + 1);
+    const std::string name = kNames[i];
     const double binned = i < 2 ? Ishigami::binned_variance(i + 1, bins) / Ishigami::variance() : 0.0;
     const double bias = (bins - 1.0) / n * (1 - binned);
     const double sigma = std::sqrt(4 * binned * (1 - binned) * (1 - binned) / n + 2.0 * (bins - 1) / (double(n) * n));

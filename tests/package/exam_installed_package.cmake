@@ -6,8 +6,8 @@
 #      build path is compiled into the installed binaries and libraries, nor written into
 #      the CMake package files;
 #   3. tests/package/consumer (find_package(backlash), case V's limit cycle through the
-#      facade and through backlash::numeric alone) configures, builds and runs — without
-#      GiNaC mapped;
+#      facade and through backlash::numeric alone, a map's sensitivity ranking through
+#      backlash::map_figures alone) configures, builds and runs — without GiNaC mapped;
 #   4. the README's C++ example, taken from README.md itself, builds and prints the
 #      output the README shows;
 #   5. the installed Python module imports and finds its data beside the prefix; the
@@ -57,6 +57,7 @@ foreach(file
     bin/backlash
     include/backlash/api/backlash.hpp include/backlash/api/derive.hpp include/backlash/model/case_spec.hpp
     include/backlash/numeric/limit_cycle.hpp include/backlash/generated/case_V.hpp
+    include/backlash/reports/map_figures.hpp include/backlash/reports/plot.hpp
     lib/cmake/backlash/backlashConfig.cmake lib/cmake/backlash/backlashConfigVersion.cmake
     lib/cmake/backlash/backlashTargets.cmake
     share/backlash/cases/V.toml share/backlash/errata/ledger.toml share/backlash/data/thesis_cases.toml
@@ -126,6 +127,13 @@ endif()
 run(numeric_only ${WORK_DIR}/consumer/numeric_only)
 if(NOT numeric_only STREQUAL "V 0.500728496422\nginac mapped: no\n")
   fail("the numeric-only consumer printed\n${numeric_only}\ninstead of\nV 0.500728496422\nginac mapped: no")
+endif()
+
+# swings 0, 0 at K = 1 and 0.01, 0.03 at K = 2: the variance of the bin means over the
+# total variance is 2/3 for K (bin means 0, 0.02) and 1/6 for backlash (0.005, 0.015)
+run(map_figures_only ${WORK_DIR}/consumer/map_figures_only)
+if(NOT map_figures_only STREQUAL "K 0.6667\nbacklash 0.1667\nginac mapped: no\n")
+  fail("the map-figures consumer printed\n${map_figures_only}\ninstead of\nK 0.6667\nbacklash 0.1667\nginac mapped: no")
 endif()
 
 # 4. the README's C++ example and the output the README shows for it

@@ -21,8 +21,11 @@
 //     index Var(E[magnitude | parameter]) / Var(magnitude), estimated from the bins of each
 //     parameter), each figure linked.
 // Bins: a grid axis has one bin per grid value (consecutive values share a bin beyond
-// max_bins_per_axis); a sampled axis has `bins` equal bins, in log10 of the value when
-// log_scale.  Same points in the same order give the same bytes.
+// max_bins_per_axis); a sampled axis has `bins` equal bins (at most max_bins_per_axis), in
+// log10 of the value when log_scale (grid values: from + (to − from)·k/(N − 1), or
+// geometric on a log axis).
+// Same points in the same order give the same bytes.  docs/map-figures.md: the figures,
+// the contour and the estimator (with its bias for few points per bin).
 #pragma once
 
 #include <cstdint>
@@ -79,6 +82,8 @@ struct MapField {
   std::vector<double> boundary_x, boundary_y;  ///< exact crossings along p or q (at most max_boundary_markers)
 };
 
+/// Not thread-safe: one thread adds the points (under MPI, the rank that gathers them, in
+/// index order — binning per rank and merging would make the sums depend on the rank count).
 class MapFigures {
  public:
   static constexpr int max_bins_per_axis = 200;        ///< beyond it, grid values share bins
@@ -106,7 +111,8 @@ class MapFigures {
 
   /// Writes figures/map_P_Q.svg (+ .pdf when gnuplot can) for every pair and summary.md
   /// into `directory` (which exists).  Returns the reason when figures could not be drawn
-  /// (gnuplot missing), else an empty string; summary.md is always written.
+  /// (gnuplot missing), else an empty string; summary.md is always written (staged, then
+  /// renamed into place; std::runtime_error when it cannot be written).
   std::string write(const std::filesystem::path& directory) const;
 
  private:

@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace backlash::reports {
@@ -38,6 +39,7 @@ struct Label {
 struct HeatMap {
   std::vector<double> x_low, x_high, y_low, y_high, value;
   std::string colour_label;
+  std::optional<std::pair<double, double>> value_range;  ///< the colour bar's; default: the values'
 };
 
 struct Plot {
