@@ -33,7 +33,11 @@ class Figures {
     std::vector<reports::MapAxis> axes;
     for (const MapAxis& a : plan.request().vary)
       axes.push_back({a.name, a.from, a.to, plan.request().sample == "grid" ? static_cast<int>(a.count) : 40, false});
-    figures_.emplace(plan.source().id(), axes, plan.request().sample);
+    try {
+      figures_.emplace(plan.source().id(), axes, plan.request().sample);
+    } catch (const std::exception& e) {  // axes it cannot bin (e.g. from = to when sampled): no figures, the rest written
+      note_ = std::string("figures not drawn: ") + e.what();
+    }
 #else
     (void)plan, (void)wanted;
 #endif
@@ -61,7 +65,7 @@ class Figures {
   }
   std::string write(const fs::path& folder) const {
 #ifdef BACKLASH_HAVE_MAP_FIGURES
-    return figures_ ? figures_->write(folder) : "";
+    return figures_ ? figures_->write(folder) : note_;
 #else
     (void)folder;
     return "figures not built (this build has no backlash_map_figures)";
@@ -71,6 +75,7 @@ class Figures {
  private:
 #ifdef BACKLASH_HAVE_MAP_FIGURES
   std::optional<reports::MapFigures> figures_;
+  std::string note_;
 #endif
 };
 
