@@ -7,6 +7,9 @@ namespace backlash::numeric {
 
 namespace {
 
+// The one place this file reads a cycle's status text.
+bool has_cycle(const LimitCycle& cycle) { return cycle.status == "limit_cycle"; }
+
 SimulationOptions sampled(const SettleOptions& o, std::vector<double>& theta_o) {
   SimulationOptions s;
   s.t_end = o.t_end;
@@ -27,7 +30,7 @@ Settle judge(const SimulationResult& run, const std::vector<double>& theta_o, co
   const double tol = o.fraction * std::fabs(o.step);
   if (run.status == SimulationStatus::Rest) {
     s.band_low = run.theta_o_final - tol, s.band_high = run.theta_o_final + tol;
-  } else if (cycle.status == "limit_cycle") {
+  } else if (has_cycle(cycle)) {
     s.band_low = cycle.theta_o_min - tol, s.band_high = cycle.theta_o_max + tol;
   } else {
     s.band_low = p.theta_R - tol, s.band_high = p.theta_R + tol;
