@@ -102,6 +102,24 @@ TEST(MapKnownAnswers, exam_thesis_case_V_is_a_grid_point) {
   EXPECT_LT(v.row.settle.time, 60);
 }
 
+TEST(MapKnownAnswers, exam_settle_time_of_the_rigid_drive_is_the_linear_two_percent_time) {
+  // b = 0: case V is the linear loop θo'' + 0.4 θo' + θo = θR (J = 1, F = 0.4, K = 1), from rest at
+  // θo = θR − 0.62.  Its error e(t) = −A e^(−ζt)(cos ωd t + ζ/ωd sin ωd t), ζ = 0.2, ωd = √(1 − ζ²);
+  // the settle time is the first t_k = k·60/2000 after which |e| <= 0.02·A at every t_k
+  // (numeric/settle.hpp; no rest within 60 s: the band is θR ± tol).
+  std::vector<api::MapRow> rows;
+  api::run_map(request({"backlash=0:0:1"}), [&rows](const api::MapRow& r) { rows.push_back(r); });
+  ASSERT_EQ(rows.size(), 1u);
+  const double A = 0.62, zeta = 0.2, wd = std::sqrt(1 - zeta * zeta);
+  auto e = [&](double t) { return -A * std::exp(-zeta * t) * (std::cos(wd * t) + zeta / wd * std::sin(wd * t)); };
+  long k = 2000;
+  while (k > 0 && std::fabs(e(static_cast<double>(k - 1) * 60 / 2000)) <= 0.02 * A) --k;
+  const double expected = static_cast<double>(k) * 60 / 2000;
+  EXPECT_EQ(api::status_of(rows[0].row), "none") << rows[0].row.reason;
+  EXPECT_EQ(rows[0].row.settle.status, "settled");
+  EXPECT_EQ(rows[0].row.settle.time, expected) << "returned " << rows[0].row.settle.time << " instead of " << expected;
+}
+
 TEST(MapKnownAnswers, exam_sobol_points_are_boost_s_sequence) {
   api::MapRequest r = request({"K=1:2:1", "backlash=0:1:1"});
   r.sample = "sobol";
