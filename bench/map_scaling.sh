@@ -12,7 +12,9 @@ n=${2:-100}
 cli="$build/bin/backlash"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-mpirun=(mpirun --allow-run-as-root --oversubscribe --mca btl self,vader)
+# As root OpenMPI needs --allow-run-as-root; 2 ranks on a small shared machine need --oversubscribe,
+# shared memory (btl self,vader) and ranks that yield while they wait instead of polling.
+mpirun=(mpirun --allow-run-as-root --oversubscribe --mca btl self,vader --mca mpi_yield_when_idle 1)
 map=(map V --vary "JL_over_Jm=0.25:4:$n" --vary "FL_over_F=0:1:$n" --vary "K=0.5:2:$n" --no-boundary --no-figures)
 points=$((n * n * n))
 
