@@ -49,5 +49,6 @@ void register_limit_cycle_command(CLI::App& app);  // cli/limit_cycle_command.cp
 void register_sweep_command(CLI::App& app);    // cli/sweep_command.cpp
 void register_import_command(CLI::App& app);   // cli/import_command.cpp
 void register_discrepancy_command(CLI::App& app);  // cli/discrepancy_command.cpp
+void register_map_command(CLI::App& app);      // cli/map_command.cpp
 
 }  // namespace backlash::cli

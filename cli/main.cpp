@@ -67,6 +67,7 @@ int main(int argument_count, char** arguments) {
   backlash::cli::register_sweep_command(app);
   backlash::cli::register_import_command(app);
   backlash::cli::register_discrepancy_command(app);
+  backlash::cli::register_map_command(app);
 
   try {
     app.parse(argument_count, arguments);

@@ -11,6 +11,7 @@ target_sources(backlash_numeric PRIVATE
   ${CMAKE_CURRENT_LIST_DIR}/src/limit_cycle.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/validated_family.cpp
   ${CMAKE_CURRENT_LIST_DIR}/src/sweep.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/src/settle.cpp             # the settle time of a step response (maps)
   ${CMAKE_CURRENT_LIST_DIR}/src/odeint_simulation.cpp    # odeint: the independent cross-check simulator
   # Effects the thesis left out (docs/effects.md)
   ${CMAKE_CURRENT_LIST_DIR}/src/effects.cpp

@@ -12,6 +12,7 @@ required_packages=(
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev libfmt-dev
   gnuplot-nox librsvg2-bin
   libceres-dev libmatio-dev
+  libhdf5-dev libopenmpi-dev openmpi-bin libboost-mpi-dev
   texlive-latex-base texlive-latex-recommended texlive-fonts-recommended poppler-utils
   python3-sympy python3-scipy python3-numpy python3-pytest python3-dev pybind11-dev
 )

@@ -112,7 +112,8 @@ struct Continuation {
   bool first = true;
 };
 
-SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& family, Continuation& c) {
+SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& family, Continuation& c,
+                   const SettleOptions& settle) {
   SweepRow row;
   row.point = point;
   if (c.first || point.series != c.series) c.guess = 0, c.warm.reset();
@@ -152,13 +153,16 @@ SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& fam
       lc.warm_start = c.warm;
       row.cycle = find_limit_cycle(gate.model(), lc);
       if (row.cycle.status == CycleStatus::LimitCycle) c.warm = row.cycle.section_state; else c.warm.reset();
+      if (settle.step != 0) row.settle = settle_time(gate.model(), row.cycle, settle);
     } else {
       LimitCycleOptions lc;
       lc.guess = c.guess;
       row.cycle = find_limit_cycle(*verdict.evaluator, lc);
       c.guess = row.cycle.status == CycleStatus::LimitCycle ? row.cycle.separation_velocity : 0;
+      if (settle.step != 0) row.settle = settle_time(*verdict.evaluator, row.cycle, settle);
     }
     shift_angles(row.cycle, reference);
+    row.settle.band_low += reference, row.settle.band_high += reference;
     row.status = sweep_status(row.cycle.status);
     row.reason = row.cycle.reason;
   } catch (const std::exception& e) {
@@ -189,7 +193,8 @@ void validate_family(ValidatedParametricFamily& family, long count, const std::f
 // and the rows are delivered in block order.  A failure (a worker's exception) stops everything.
 class BlockQueue {
  public:
-  BlockQueue(long blocks, long window) : blocks_(blocks), window_(window) {}
+  BlockQueue(long first_block, long blocks, long window)
+      : blocks_(blocks), window_(window), next_block_(first_block), next_delivery_(first_block) {}
   /// The next block to compute, or nothing when done or stopping.
   std::optional<long> take() {
     std::unique_lock<std::mutex> lock(mutex_);
@@ -235,22 +240,33 @@ class BlockQueue {
   std::mutex mutex_;
   std::condition_variable changed_;
   std::map<long, std::vector<SweepRow>> finished_;
-  long next_block_ = 0, next_delivery_ = 0;
+  long next_block_, next_delivery_;
   bool stopping_ = false;
   std::exception_ptr failure_;
 };
 
 }  // namespace
 
+std::shared_ptr<const ValidatedParametricFamily> sweep_family(long count, const std::function<SweepPoint(long)>& point,
+                                                              const SweepOptions& options) {
+  auto family = std::make_shared<ValidatedParametricFamily>();
+  validate_family(*family, count, point, options.validation_samples);
+  return family;
+}
+
 void run_sweep_streamed(long count, const std::function<SweepPoint(long)>& point, const SweepOptions& options,
                         const std::function<void(const SweepRow&)>& row, SweepSummary* summary) {
   if (count <= 0) return;
-  ValidatedParametricFamily family;
-  validate_family(family, count, point, options.validation_samples);
+  const std::shared_ptr<const ValidatedParametricFamily> shared =
+      options.family ? options.family : sweep_family(count, point, options);
+  const ValidatedParametricFamily& family = *shared;
   const long block = std::max(1, options.block);
-  const long blocks = (count + block - 1) / block;
-  const long threads = std::max<long>(1, std::min<long>(options.threads, blocks));
-  BlockQueue queue(blocks, 4 * threads);  // blocks computed ahead of the one being delivered
+  const long end = options.last < 0 ? count : std::min(count, options.last);
+  const long first_block = std::max(0L, options.first) / block;
+  const long blocks = (end + block - 1) / block;
+  if (first_block >= blocks) return;
+  const long threads = std::max<long>(1, std::min<long>(options.threads, blocks - first_block));
+  BlockQueue queue(first_block, blocks, 4 * threads);  // blocks computed ahead of the one being delivered
   std::atomic<long> done{0};
   std::mutex progress_mutex;
   auto work = [&] {
@@ -258,12 +274,12 @@ void run_sweep_streamed(long count, const std::function<SweepPoint(long)>& point
       while (const std::optional<long> b = queue.take()) {
         std::vector<SweepRow> rows;
         Continuation continuation;
-        for (long i = *b * block; i < std::min(count, (*b + 1) * block); ++i) {
-          rows.push_back(sweep_row(point(i), family, continuation));
+        for (long i = *b * block; i < std::min(end, (*b + 1) * block); ++i) {
+          rows.push_back(sweep_row(point(i), family, continuation, options.settle));
           const long finished_points = ++done;
           if (options.progress) {
             std::lock_guard<std::mutex> lock(progress_mutex);
-            options.progress(finished_points, count);
+            options.progress(finished_points, end - first_block * block);
           }
         }
         queue.put(*b, std::move(rows));

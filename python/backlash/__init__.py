@@ -39,7 +39,7 @@ from ._core import (BadInput, Case, CaseFileError, Cycle, Discrepancy, MeasuredD
                     Sweep, Trace, Validation, ValidationFailed)
 
 __all__ = [
-    "load", "sweep", "read_record", "record", "discrepancy", "validate_branches", "derive_general", "data_dir",
+    "load", "sweep", "map", "read_record", "record", "discrepancy", "validate_branches", "derive_general", "data_dir",
     "Case", "Simulation", "Trace", "Cycle", "Sweep", "Record", "Discrepancy", "Validation", "Derivation",
     "BadInput", "CaseFileError", "MeasuredDataError", "ValidationFailed",
 ]
@@ -126,6 +126,22 @@ def sweep(target, vary=None, start=None, stop=None, points=101, threads=2):
         if start is None or stop is None:
             raise BadInput(f"{'start' if start is None else 'stop'}: required for a case")
     return _core.sweep(target, vary or "", float(start or 0), float(stop or 0), int(points), int(threads))
+
+
+def map(target, vary, sample="grid", points=0, threads=2, step=None, out=None, resume=False):
+    """A design-space map (docs/design.md, "Design-space maps"): limit cycles over several
+    parameters.  vary: ["JL_over_Jm=0.25:4:40", "FL_over_F=0:1:40"] (NAME=FROM:TO:N, the names
+    of sweep()); sample "grid", "sobol" or "lhs" (then `points`); step: the settle time's step
+    (default the case's).  Without `out`: a dict of NumPy columns x (points × axes), status,
+    peak_to_peak, period, multiplier, settle_time, in point order.  With `out`: the folder of
+    `backlash map --out` (points.csv, boundary.csv, map.h5, figures), resumable; returns a
+    summary dict."""
+    target = _os.fspath(target)
+    vary = [vary] if isinstance(vary, str) else list(vary)
+    step = None if step is None else float(step)
+    if out is None:
+        return _core.map_rows(target, vary, sample, int(points), int(threads), step)
+    return _core.map_write(target, vary, sample, int(points), int(threads), step, _os.fspath(out), bool(resume))
 
 
 def read_record(file):

@@ -7,6 +7,7 @@
 //   BadInput, CaseFileError, MeasuredDataError   (subclasses of ValueError)
 //   ValidationFailed                              (a subclass of RuntimeError)
 #include "backlash/api/backlash.hpp"
+#include "backlash/api/map.hpp"
 #include "backlash/model/data_dir.hpp"
 
 #include <pybind11/numpy.h>
@@ -363,6 +364,74 @@ void bind_sweep(py::module_& m) {
       Release());
 }
 
+// design-space maps (backlash/api/map.hpp)
+void bind_map(py::module_& m) {
+  auto request_of = [](const std::string& target, const std::vector<std::string>& vary, const std::string& sample,
+                       long points, int threads, std::optional<double> step) {
+    api::MapRequest r;
+    r.target = target;
+    for (const std::string& v : vary) r.vary.push_back(api::parse_vary(v));
+    r.sample = sample;
+    r.points = points;
+    r.threads = threads;
+    r.step = step;
+    return r;
+  };
+  m.def(
+      "map_rows",
+      [request_of](const std::string& target, const std::vector<std::string>& vary, const std::string& sample,
+                   long points, int threads, std::optional<double> step) {
+        const api::MapRequest r = request_of(target, vary, sample, points, threads, step);
+        std::vector<double> x, peak_to_peak, period, multiplier, settle;
+        std::vector<std::string> status;
+        {
+          py::gil_scoped_release release;
+          api::run_map(r, [&](const api::MapRow& row) {
+            x.insert(x.end(), row.x.begin(), row.x.end());
+            status.push_back(api::status_of(row.row));
+            const bool cycle = status.back() == "limit_cycle";
+            peak_to_peak.push_back(cycle ? row.row.cycle.peak_to_peak : NAN);
+            period.push_back(cycle ? row.row.cycle.period : NAN);
+            multiplier.push_back(cycle ? row.row.cycle.multiplier : NAN);
+            settle.push_back(row.row.settle.time);
+          });
+        }
+        py::array_t<double> xs = array(x);
+        xs.resize({static_cast<py::ssize_t>(status.size()), static_cast<py::ssize_t>(r.vary.size())});
+        py::dict out;
+        out["x"] = xs;
+        out["status"] = status;
+        out["peak_to_peak"] = array(peak_to_peak);
+        out["period"] = array(period);
+        out["multiplier"] = array(multiplier);
+        out["settle_time"] = array(settle);
+        return out;
+      },
+      py::arg("target"), py::arg("vary"), py::arg("sample"), py::arg("points"), py::arg("threads"), py::arg("step"));
+  m.def(
+      "map_write",
+      [request_of](const std::string& target, const std::vector<std::string>& vary, const std::string& sample,
+                   long points, int threads, std::optional<double> step, const std::filesystem::path& out, bool resume) {
+        api::MapOutput o;
+        o.out = out;
+        o.resume = resume;
+        const api::MapRequest r = request_of(target, vary, sample, points, threads, step);
+        api::MapSummary s;
+        {
+          py::gil_scoped_release release;
+          s = api::write_map(r, o);
+        }
+        py::dict d;
+        d["points"] = s.points;
+        d["resumed_from"] = s.resumed_from;
+        d["boundary_points"] = s.boundary_points;
+        d["figures_note"] = s.figures_note;
+        return d;
+      },
+      py::arg("target"), py::arg("vary"), py::arg("sample"), py::arg("points"), py::arg("threads"), py::arg("step"),
+      py::arg("out"), py::arg("resume"));
+}
+
 // records, discrepancy
 void bind_records_and_discrepancy(py::module_& m) {
   py::class_<measurements::MeasuredRecord>(m, "Record")
@@ -452,6 +521,7 @@ PYBIND11_MODULE(_core, m) {
   bind_trace(m);
   bind_cycle(m);
   bind_sweep(m);
+  bind_map(m);
   bind_records_and_discrepancy(m);
   bind_validation(m);
 }

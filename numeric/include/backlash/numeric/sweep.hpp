@@ -27,8 +27,10 @@
 
 #include "backlash/numeric/effects.hpp"
 #include "backlash/numeric/limit_cycle.hpp"
+#include "backlash/numeric/settle.hpp"
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -57,13 +59,23 @@ struct SweepRow {
   std::string reason;  ///< for every status but "limit_cycle": why, in words
   std::string branches;
   LimitCycle cycle;
+  Settle settle;       ///< the step response's settle time (settle.hpp) when SweepOptions::settle.step != 0
 };
+
+class ValidatedParametricFamily;
 
 struct SweepOptions {
   int threads = 2;
   int validation_samples = 64;  ///< validate the parametric family at this many evenly spaced points (ends included)
   int block = 32;               ///< points per warm-start block (the result does not depend on `threads`)
   std::function<void(long done, long total)> progress;  ///< called from worker threads (serialised)
+  /// Maps (api/map.hpp): the step response's settle time of every row (settle.hpp; step 0: none).
+  SettleOptions settle{};
+  /// Compute only the points [first, last) of the `count` (last < 0: to the end); `first` must
+  /// start a block.  With `family` (sweep_family of the same count and points) the rows are
+  /// those of the whole run, bit for bit: how a map splits its points over ranks and resumes.
+  long first = 0, last = -1;
+  std::shared_ptr<const ValidatedParametricFamily> family{};
 };
 
 struct SweepSummary {
@@ -79,6 +91,12 @@ std::vector<SweepRow> run_sweep(const std::vector<SweepPoint>& points, const Swe
 /// done.  An exception thrown by `row` stops the workers and is rethrown.
 void run_sweep_streamed(long count, const std::function<SweepPoint(long)>& point, const SweepOptions& options,
                         const std::function<void(const SweepRow&)>& row, SweepSummary* summary = nullptr);
+
+/// The validated family of a sweep of `count` points (validated at `options.validation_samples`
+/// evenly spaced points, the same for any split of the run): computed once, shared by the calls
+/// of run_sweep_streamed over parts of the points (SweepOptions::family).
+std::shared_ptr<const ValidatedParametricFamily> sweep_family(long count, const std::function<SweepPoint(long)>& point,
+                                                              const SweepOptions& options);
 
 /// Figure 31: `n` values of FL/F in [0, 1] for each of JL = Jm, JL = 4 Jm (2n points).
 std::vector<SweepPoint> figure31_points(int n);

@@ -1,0 +1,262 @@
+// map_output.cpp — `backlash map --out DIR`: the rows streamed into a partial folder with a
+// checkpoint at every block, on one process or over MPI ranks (MapTransport), then the final
+// files (HDF5, boundary, figures) and the atomic rename (api/map.hpp; docs/design.md,
+// "Design-space maps").
+#include "backlash/api/map.hpp"
+
+#include "map_output.hpp"
+#include "map_store.hpp"
+
+#include "backlash/numeric/validated_family.hpp"
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+namespace backlash::api {
+
+namespace fs = std::filesystem;
+using detail::Interrupted;
+
+namespace detail {
+
+std::string fingerprint(const MapPlan& plan, const MapOutput& output) {
+  const MapRequest& r = plan.request();
+  std::string out = "backlash map checkpoint 1\ncase " + plan.source().id() + "\n" + plan.source().case_file();
+  for (const MapAxis& a : r.vary) appendf(out, "vary %s %.17g %.17g %ld\n", a.name.c_str(), a.from, a.to, a.count);
+  appendf(out, "sample %s %ld seed %llu block %d step %.17g t_end %.17g boundary %d hdf5 %d figures %d\n",
+          r.sample.c_str(), plan.count(), static_cast<unsigned long long>(r.seed), r.block, plan.step(), plan.t_end(),
+          r.boundary ? 1 : 0, output.hdf5 ? 1 : 0, output.figures ? 1 : 0);
+  return out;
+}
+
+fs::path staging_path(const fs::path& target) {
+  const fs::path absolute = fs::absolute(target).lexically_normal();
+  const fs::path clean = absolute.has_filename() ? absolute : absolute.parent_path();
+  std::string name = ".";  // (built step by step: GCC 12 warns falsely on "." + string)
+  name += clean.filename().string();
+  name += ".map-partial";
+  return clean.parent_path() / name;
+}
+
+// The rules of reports/output_directory.hpp: a new folder, an empty one, or a report's.
+void check_target(const fs::path& target) {
+  if (target.empty()) throw BadInput("out", "empty path");
+  const fs::path absolute = fs::absolute(target).lexically_normal();
+  const fs::path clean = absolute.has_filename() ? absolute : absolute.parent_path();
+  if (clean == clean.root_path() || clean.filename() == "." || clean.filename() == "..")
+    throw BadInput("out", target.string() + ": not a folder name");
+  std::error_code error;
+  if (!fs::is_directory(clean.parent_path(), error))
+    throw BadInput("out", target.string() + ": the folder " + clean.parent_path().string() + " does not exist");
+  const fs::file_status status = fs::symlink_status(clean, error);
+  if (!fs::exists(status)) return;
+  if (!fs::is_directory(status)) throw BadInput("out", target.string() + ": exists and is not a folder");
+  if (fs::is_empty(clean, error) || fs::exists(clean / ".backlash-report")) return;
+  throw BadInput("out", target.string() + ": the folder exists and is not a backlash output; choose a new folder");
+}
+
+RowWriter::RowWriter(const fs::path& staging, const MapPlan& plan, const MapOutput& output, std::string print,
+                     long done, std::uintmax_t csv_bytes, std::uintmax_t bin_bytes)
+    : staging_(staging), print_(std::move(print)), done_(done), csv_bytes_(csv_bytes), bin_bytes_(bin_bytes),
+      block_(plan.request().block), count_(plan.count()), stop_after_(output.stop_after),
+      interrupted_(output.interrupted), progress_(output.progress) {
+  if (done == 0) {
+    std::ofstream(staging / "points.csv", std::ios::binary) << map_csv_header(plan);
+    std::ofstream(staging / "points.bin", std::ios::binary);
+    csv_bytes_ = fs::file_size(staging / "points.csv");
+    bin_bytes_ = 0;
+  }
+  // The completed prefix only: a partial block's rows are cut off and recomputed.
+  fs::resize_file(staging / "points.csv", csv_bytes_);
+  fs::resize_file(staging / "points.bin", bin_bytes_);
+  csv_ = std::fopen((staging / "points.csv").c_str(), "ab");
+  bin_ = std::fopen((staging / "points.bin").c_str(), "ab");
+  if (!csv_ || !bin_) throw std::runtime_error("cannot open the partial map in " + staging.string());
+  checkpoint();
+}
+
+RowWriter::~RowWriter() { close(); }
+
+void RowWriter::close() {
+  if (csv_) std::fclose(csv_), csv_ = nullptr;
+  if (bin_) std::fclose(bin_), bin_ = nullptr;
+}
+
+void RowWriter::take(const std::string& record, const std::string& csv) {
+  if (std::fwrite(csv.data(), 1, csv.size(), csv_) != csv.size() ||
+      std::fwrite(record.data(), 1, record.size(), bin_) != record.size())
+    throw std::runtime_error("cannot write the partial map in " + staging_.string());
+  ++written_;
+  pending_csv_ += csv.size(), pending_bin_ += record.size();
+  const long index = done_ + pending_rows_++;
+  if ((index + 1) % block_ == 0 || index + 1 == count_) {
+    if (std::fflush(csv_) != 0 || std::fflush(bin_) != 0) throw std::runtime_error("cannot write " + staging_.string());
+    done_ = index + 1, csv_bytes_ += pending_csv_, bin_bytes_ += pending_bin_;
+    pending_rows_ = 0, pending_csv_ = 0, pending_bin_ = 0;
+    checkpoint();
+    if (progress_) progress_(done_, count_);
+    if (interrupted_ && interrupted_()) throw Interrupted{};
+  }
+  if (stop_after_ >= 0 && written_ >= stop_after_) throw Interrupted{};
+}
+
+void RowWriter::checkpoint() {
+  const fs::path file = staging_ / "checkpoint", temporary = staging_ / "checkpoint.new";
+  {
+    std::ofstream out(temporary, std::ios::binary);
+    out << print_ << "done " << done_ << "\ncsv " << csv_bytes_ << "\nbin " << bin_bytes_ << "\n";
+    if (!out.flush()) throw std::runtime_error("cannot write the checkpoint in " + staging_.string());
+  }
+  fs::rename(temporary, file);
+}
+
+// The checkpoint of an interrupted run of the same request: done, csv bytes, bin bytes.
+bool read_checkpoint(const fs::path& staging, const std::string& print, long& done, std::uintmax_t& csv,
+                     std::uintmax_t& bin) {
+  std::ifstream in(staging / "checkpoint", std::ios::binary);
+  if (!in) return false;
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string all = text.str();
+  if (all.compare(0, print.size(), print) != 0) return false;
+  std::istringstream tail(all.substr(print.size()));
+  std::string a, b, c;
+  return static_cast<bool>(tail >> a >> done >> b >> csv >> c >> bin) && a == "done" && b == "csv" && c == "bin";
+}
+
+}  // namespace detail
+
+namespace {
+
+// Opens the partial folder (fresh or resumed) at rank 0; returns the first point to compute.
+std::unique_ptr<detail::RowWriter> open_partial(const MapPlan& plan, const MapOutput& output) {
+  detail::check_target(output.out);
+  const fs::path staging = detail::staging_path(output.out);
+  const std::string print = detail::fingerprint(plan, output);
+  long done = 0;
+  std::uintmax_t csv = 0, bin = 0;
+  std::error_code error;
+  if (output.resume) {
+    if (!detail::read_checkpoint(staging, print, done, csv, bin))
+      throw BadInput("resume", "no interrupted map of this request at " + staging.string() +
+                                   " (run without --resume to start it; the case, --vary, --sample, --points, "
+                                   "--step and the outputs must be the same)");
+  } else {
+    if (fs::exists(staging, error)) {
+      if (!fs::is_directory(staging, error) || (!fs::is_empty(staging, error) && !fs::exists(staging / "checkpoint")))
+        throw BadInput("out", staging.string() + " exists and is not a partial map; remove it");
+      fs::remove_all(staging);
+    }
+    fs::create_directory(staging);
+  }
+  return std::make_unique<detail::RowWriter>(staging, plan, output, print, done, csv, bin);
+}
+
+numeric::SweepOptions options_of(const MapPlan& plan) {
+  numeric::SweepOptions o;
+  o.threads = plan.request().threads;
+  o.block = plan.request().block;
+  o.settle.step = plan.step();
+  o.settle.t_end = plan.t_end();
+  return o;
+}
+
+// Rows of points [first, last) handed to `take(record, csv)` in order.
+void compute(const MapPlan& plan, numeric::SweepOptions options, long first, long last,
+             const std::function<void(const std::string&, const std::string&)>& take) {
+  options.first = first, options.last = last;
+  long index = first;
+  numeric::run_sweep_streamed(plan.count(), [&plan](long i) { return plan.point(i); }, options,
+                              [&](const numeric::SweepRow& row) {
+                                const MapRow r{index, plan.values(index), row};
+                                std::string record;
+                                detail::append_record(record, r);
+                                take(record, map_csv_row(r));
+                                ++index;
+                              });
+}
+
+// MPI: rounds of `per_rank` blocks per rank, contiguous, gathered at rank 0 in order.
+bool compute_distributed(const MapPlan& plan, const numeric::SweepOptions& options, MapTransport& t, long first,
+                         detail::RowWriter* writer) {
+  const long block = options.block, count = plan.count();
+  const long per_rank = 8L * options.threads * block;
+  bool stopped = false;
+  for (long next = first;;) {
+    std::string go = t.rank() == 0 ? (stopped ? std::string("stop") : "go " + std::to_string(next)) : std::string();
+    t.broadcast(go);
+    if (go == "stop") return false;
+    next = std::stol(go.substr(3));
+    if (next >= count) return true;
+    const long begin = std::min(count, next + t.rank() * per_rank), end = std::min(count, begin + per_rank);
+    std::string piece;
+    if (begin < end)
+      compute(plan, options, begin, end, [&](const std::string& record, const std::string& csv) {
+        const auto length = static_cast<std::uint32_t>(csv.size());
+        piece += record;
+        piece.append(reinterpret_cast<const char*>(&length), 4);
+        piece += csv;
+      });
+    const std::vector<std::string> pieces = t.gather(piece);
+    const std::size_t size = detail::MapRecord::size(plan.request().vary.size());
+    try {
+      for (const std::string& p : pieces)
+        for (std::size_t at = 0; at < p.size();) {
+          std::uint32_t length = 0;
+          std::memcpy(&length, p.data() + at + size, 4);
+          writer->take(p.substr(at, size), p.substr(at + size + 4, length));
+          at += size + 4 + length;
+        }
+    } catch (const Interrupted&) {
+      stopped = true;
+    }
+    next += t.size() * per_rank;
+  }
+}
+
+}  // namespace
+
+std::filesystem::path map_partial_folder(const std::filesystem::path& out) { return detail::staging_path(out); }
+
+MapSummary write_map(const MapRequest& request, const MapOutput& output) {
+  const MapPlan plan(request);
+  MapTransport* t = output.transport;
+  const bool root = !t || t->rank() == 0;
+  std::unique_ptr<detail::RowWriter> writer;
+  std::string start;
+  try {
+    if (root) writer = open_partial(plan, output), start = "ok " + std::to_string(writer->done());
+  } catch (const std::exception& e) {
+    if (!t || t->size() == 1) throw;
+    start = std::string("error ") + e.what();
+  }
+  if (t && t->size() > 1) t->broadcast(start);
+  if (start.rfind("error ", 0) == 0) throw BadInput("out", start.substr(6));
+  MapSummary summary;
+  summary.points = plan.count();
+  summary.resumed_from = std::stol(start.substr(3));
+  const numeric::SweepOptions options = [&] {
+    numeric::SweepOptions o = options_of(plan);
+    o.family = numeric::sweep_family(plan.count(), [&plan](long i) { return plan.point(i); }, o);
+    return o;
+  }();
+  bool complete = true;
+  if (t && t->size() > 1) {
+    complete = compute_distributed(plan, options, *t, summary.resumed_from, writer.get());
+  } else {
+    try {
+      compute(plan, options, summary.resumed_from, plan.count(),
+              [&](const std::string& record, const std::string& csv) { writer->take(record, csv); });
+    } catch (const Interrupted&) {
+      complete = false;
+    }
+  }
+  if (root) summary.written = writer->written(), summary.kept = writer->done(), writer->close();
+  summary.complete = complete;
+  if (!complete) return summary;
+  detail::finish_map(plan, output, options.family, summary);
+  return summary;
+}
+
+}  // namespace backlash::api

@@ -1,0 +1,62 @@
+// map_output.hpp — the pieces of `write_map` (map_output.cpp, map_finish.cpp): the partial
+// folder's row writer and checkpoint, and the final files.
+#pragma once
+
+#include "backlash/api/map.hpp"
+
+#include "format.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+namespace backlash::api::detail {
+
+/// A stop asked for (a signal, or MapOutput::stop_after): the partial folder stays, resumable.
+struct Interrupted {};
+
+/// The request as the checkpoint records it: a resume must match it exactly (threads and ranks
+/// are not part of it: they do not change the output).
+std::string fingerprint(const MapPlan& plan, const MapOutput& output);
+/// ".DIR.map-partial" beside DIR.
+std::filesystem::path staging_path(const std::filesystem::path& target);
+/// reports/output_directory.hpp's rules for --out (BadInput "out").
+void check_target(const std::filesystem::path& target);
+
+/// Rank 0: appends each row to points.csv and points.bin in index order; at every block end
+/// flushes both and rewrites the checkpoint (the fingerprint, the points done, the two files'
+/// lengths), then polls for a stop.  Throws Interrupted to stop.
+class RowWriter {
+ public:
+  RowWriter(const std::filesystem::path& staging, const MapPlan& plan, const MapOutput& output, std::string print,
+            long done, std::uintmax_t csv_bytes, std::uintmax_t bin_bytes);
+  ~RowWriter();
+  RowWriter(const RowWriter&) = delete;
+  RowWriter& operator=(const RowWriter&) = delete;
+  void take(const std::string& record, const std::string& csv);
+  long done() const { return done_; }
+  long written() const { return written_; }
+  const std::filesystem::path& staging() const { return staging_; }
+  void close();
+
+ private:
+  void checkpoint();
+  std::filesystem::path staging_;
+  std::string print_;
+  long done_ = 0;
+  std::uintmax_t csv_bytes_ = 0, bin_bytes_ = 0, pending_csv_ = 0, pending_bin_ = 0;
+  long pending_rows_ = 0, written_ = 0;
+  long block_, count_, stop_after_;
+  std::function<bool()> interrupted_;
+  std::function<void(long, long)> progress_;
+  std::FILE* csv_ = nullptr;
+  std::FILE* bin_ = nullptr;
+};
+
+/// Every rank: the final files from points.bin (rank 0), the boundary solved over all ranks,
+/// map.json, then the partial folder renamed onto --out (rank 0).
+void finish_map(const MapPlan& plan, const MapOutput& output,
+                const std::shared_ptr<const numeric::ValidatedParametricFamily>& family, MapSummary& summary);
+
+}  // namespace backlash::api::detail

@@ -1,0 +1,147 @@
+// map_rows.cpp — a map's rows: computed in order (run_map), written as CSV, and the
+// cycle/no-cycle boundary solved along grid lines (api/map.hpp).
+#include "backlash/api/map.hpp"
+
+#include "backlash/numeric/validated_family.hpp"
+
+#include <boost/math/tools/roots.hpp>
+
+#include <charconv>
+#include <cmath>
+
+namespace backlash::api {
+
+namespace {
+
+// The shortest text that reads back to the same double; empty for NaN (a cell the row lacks).
+void append_number(std::string& out, double value) {
+  if (std::isnan(value)) return;
+  char text[32];
+  const auto result = std::to_chars(text, text + sizeof text, value);
+  out.append(text, result.ptr);
+}
+
+void append_quoted(std::string& out, const std::string& text) {
+  if (text.find_first_of(",\"\n\r") == std::string::npos) {
+    out += text;
+    return;
+  }
+  out += '"';
+  for (const char c : text) {
+    if (c == '"') out += '"';
+    out += (c == '\n' || c == '\r') ? ' ' : c;
+  }
+  out += '"';
+}
+
+const char* parameter_columns =
+    "Jm,Fm,JL,FL,K,backlash,reference,coulomb_motor,coulomb_load,restitution,saturation,stiffness,damping,delay,"
+    "torque_offset";
+
+}  // namespace
+
+std::string map_csv_header(const MapPlan& plan) {
+  std::string out = "index";
+  for (const MapAxis& a : plan.request().vary) out += ",x_" + a.name;
+  out += ",";
+  out += parameter_columns;
+  out += ",status,reason,branches,peak_to_peak,amplitude,period,separation_velocity,multiplier,settle_time,settle_status\n";
+  return out;
+}
+
+std::string map_csv_row(const MapRow& r) {
+  std::string out = std::to_string(r.index);
+  for (const double x : r.x) out += ',', append_number(out, x);
+  const numeric::Parameters& p = r.row.point.parameters;
+  const numeric::Effects& e = r.row.point.effects;
+  for (const double v : {p.Jm, p.Fm, p.JL, p.FL, p.K, p.backlash, p.theta_R, e.coulomb_motor, e.coulomb_load,
+                         e.restitution, e.saturation, e.mesh_stiffness, e.mesh_damping, e.delay, e.torque_offset})
+    out += ',', append_number(out, v);
+  const std::string status = status_of(r.row);
+  const bool cycle = status == "limit_cycle";
+  out += "," + status + ",";
+  append_quoted(out, r.row.reason);
+  out += "," + r.row.branches;
+  const numeric::LimitCycle& c = r.row.cycle;
+  for (const double v : {c.peak_to_peak, c.amplitude, c.period, c.separation_velocity, c.multiplier})
+    out += ',', append_number(out, cycle ? v : NAN);
+  const bool computed = status == "limit_cycle" || status == "none" || status == "divergent";
+  out += ',', append_number(out, computed ? r.row.settle.time : NAN);
+  out += ',' + (computed ? r.row.settle.status : std::string());
+  return out + "\n";
+}
+
+std::string map_boundary_csv_header(const MapPlan& plan) {
+  std::string out = "along,lower,upper,kind";
+  for (const MapAxis& a : plan.request().vary) out += ",x_" + a.name;
+  return out + ",bracket_low,bracket_high,evaluations\n";
+}
+
+std::string map_boundary_csv_row(const MapBoundaryRow& b) {
+  std::string out = std::to_string(b.along) + "," + std::to_string(b.lower) + "," + std::to_string(b.upper) + "," + b.kind;
+  for (const double x : b.x) out += ',', append_number(out, x);
+  out += ',', append_number(out, b.low);
+  out += ',', append_number(out, b.high);
+  return out + "," + std::to_string(b.evaluations) + "\n";
+}
+
+namespace {
+
+numeric::SweepOptions sweep_options(const MapPlan& plan) {
+  numeric::SweepOptions o;
+  o.threads = plan.request().threads;
+  o.block = plan.request().block;
+  o.settle.step = plan.step();
+  o.settle.t_end = plan.t_end();
+  return o;
+}
+
+}  // namespace
+
+void run_map(const MapRequest& request, const std::function<void(const MapRow&)>& sink) {
+  const MapPlan plan(request);
+  const auto point = [&plan](long i) { return plan.point(i); };
+  const numeric::SweepOptions options = sweep_options(plan);
+  long index = 0;
+  numeric::run_sweep_streamed(plan.count(), point, options, [&](const numeric::SweepRow& row) {
+    sink(MapRow{index, plan.values(index), row});
+    ++index;
+  });
+}
+
+MapBoundaryRow solve_boundary(const MapPlan& plan, int along, long lower, long upper, bool cycle_at_lower,
+                              std::shared_ptr<const numeric::ValidatedParametricFamily> family) {
+  MapBoundaryRow b;
+  b.along = along, b.lower = lower, b.upper = upper;
+  b.kind = cycle_at_lower ? "dies" : "appears";
+  b.x = plan.values(lower);
+  const auto k = static_cast<std::size_t>(along);
+  // s(t): one cold point at t on the line, the sweep's own row (numeric/sweep.hpp).
+  numeric::SweepOptions options = sweep_options(plan);
+  options.threads = 1;
+  options.settle.step = 0;
+  options.family = std::move(family);
+  auto s = [&](double t) {
+    const numeric::SweepPoint point = plan.point_at(lower, along, t);
+    ++b.evaluations;
+    std::string status;
+    numeric::run_sweep_streamed(1, [&](long) { return point; }, options,
+                                [&](const numeric::SweepRow& row) { status = status_of(row); });
+    return status == "limit_cycle" ? -1.0 : 1.0;
+  };
+  double a = b.x[k], c = plan.values(upper)[k];
+  if (a > c) std::swap(a, c);
+  const double fa = s(a), fc = s(c);
+  b.low = a, b.high = c;
+  if (fa == fc) {  // cold searches agree at both ends: the grid's verdict was a warm start's
+    b.kind += " (unresolved)";
+  } else {
+    std::uintmax_t iterations = 200;
+    const auto root = boost::math::tools::bisect(s, a, c, boost::math::tools::eps_tolerance<double>(40), iterations);
+    b.low = root.first, b.high = root.second;
+  }
+  b.x[k] = 0.5 * (b.low + b.high);
+  return b;
+}
+
+}  // namespace backlash::api

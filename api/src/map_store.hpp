@@ -1,0 +1,81 @@
+// map_store.hpp — a map's rows as fixed-size binary records (what ranks send to rank 0 and
+// what points.bin holds until the end), and the HDF5 writer (map_hdf5.cpp).
+#pragma once
+
+#include "backlash/api/map.hpp"
+
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace backlash::api::detail {
+
+/// The statuses a record stores as a code (status_of's texts; anything else is "other").
+inline const std::vector<std::string>& map_status_names() {
+  static const std::vector<std::string> names = {"limit_cycle", "none",  "divergent", "unvalidated",
+                                                 "refused",     "error", "other"};
+  return names;
+}
+inline std::int8_t map_status_code(const std::string& status) {
+  const auto& names = map_status_names();
+  for (std::size_t k = 0; k + 1 < names.size(); ++k)
+    if (names[k] == status) return static_cast<std::int8_t>(k);
+  return static_cast<std::int8_t>(names.size() - 1);
+}
+
+/// A record: index (int64), status code (int64), then doubles: the d varied values, the 15
+/// parameters of points.csv, peak_to_peak, amplitude, period, separation_velocity, multiplier,
+/// settle_time (NaN when the row has none).
+struct MapRecord {
+  std::int64_t index = 0, status = 0;
+  std::vector<double> values;
+  static std::size_t size(std::size_t d) { return 16 + 8 * (d + 21); }
+};
+
+inline void append_record(std::string& out, const MapRow& r) {
+  const std::int64_t head[2] = {r.index, map_status_code(status_of(r.row))};
+  out.append(reinterpret_cast<const char*>(head), sizeof head);
+  const numeric::Parameters& p = r.row.point.parameters;
+  const numeric::Effects& e = r.row.point.effects;
+  const bool cycle = head[1] == 0, computed = head[1] <= 2;
+  const numeric::LimitCycle& c = r.row.cycle;
+  std::vector<double> v = r.x;
+  for (const double x : {p.Jm, p.Fm, p.JL, p.FL, p.K, p.backlash, p.theta_R, e.coulomb_motor, e.coulomb_load,
+                         e.restitution, e.saturation, e.mesh_stiffness, e.mesh_damping, e.delay, e.torque_offset})
+    v.push_back(x);
+  for (const double x : {c.peak_to_peak, c.amplitude, c.period, c.separation_velocity, c.multiplier})
+    v.push_back(cycle ? x : NAN);
+  v.push_back(computed ? r.row.settle.time : NAN);
+  out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(double));
+}
+
+inline MapRecord read_record(const char* bytes, std::size_t d) {
+  MapRecord r;
+  std::memcpy(&r.index, bytes, 8);
+  std::memcpy(&r.status, bytes + 8, 8);
+  r.values.resize(d + 21);
+  std::memcpy(r.values.data(), bytes + 16, 8 * (d + 21));
+  return r;
+}
+
+/// map.h5 (docs/design.md, "Design-space maps"): dataset /points (compound, one element per
+/// point, chunks of 4096, extendible) and /boundary; no time stamps (byte-reproducible).
+class MapHdf5 {
+ public:
+  MapHdf5(const std::filesystem::path& file, const MapPlan& plan);
+  ~MapHdf5();
+  MapHdf5(const MapHdf5&) = delete;
+  MapHdf5& operator=(const MapHdf5&) = delete;
+  void add(const MapRecord& record);
+  void add_boundary(const MapBoundaryRow& row);
+  void close();  ///< flushes and closes (throws on an HDF5 failure)
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace backlash::api::detail
