@@ -153,15 +153,6 @@ std::unique_ptr<detail::RowWriter> open_partial(const MapPlan& plan, const MapOu
   return std::make_unique<detail::RowWriter>(staging, plan, output, print, done, csv, bin);
 }
 
-numeric::SweepOptions options_of(const MapPlan& plan) {
-  numeric::SweepOptions o;
-  o.threads = plan.request().threads;
-  o.block = plan.request().block;
-  o.settle.step = plan.step();
-  o.settle.t_end = plan.t_end();
-  return o;
-}
-
 // Rows of points [first, last) handed to `take(record, csv)` in order.
 void compute(const MapPlan& plan, numeric::SweepOptions options, long first, long last,
              const std::function<void(const std::string&, const std::string&)>& take) {
@@ -237,7 +228,7 @@ MapSummary write_map(const MapRequest& request, const MapOutput& output) {
   summary.points = plan.count();
   summary.resumed_from = std::stol(start.substr(3));
   const numeric::SweepOptions options = [&] {
-    numeric::SweepOptions o = options_of(plan);
+    numeric::SweepOptions o = detail::sweep_options(plan);
     o.family = numeric::sweep_family(plan.count(), [&plan](long i) { return plan.point(i); }, o);
     return o;
   }();

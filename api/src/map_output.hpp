@@ -19,6 +19,8 @@ struct Interrupted {};
 /// The request as the checkpoint records it: a resume must match it exactly (threads and ranks
 /// are not part of it: they do not change the output).
 std::string fingerprint(const MapPlan& plan, const MapOutput& output);
+/// The sweep's options for the map's points: threads, block, and the settle time's step.
+numeric::SweepOptions sweep_options(const MapPlan& plan);
 /// ".DIR.map-partial" beside DIR.
 std::filesystem::path staging_path(const std::filesystem::path& target);
 /// reports/output_directory.hpp's rules for --out (BadInput "out").

@@ -2,6 +2,8 @@
 // cycle/no-cycle boundary solved along grid lines (api/map.hpp).
 #include "backlash/api/map.hpp"
 
+#include "map_output.hpp"
+
 #include "backlash/numeric/validated_family.hpp"
 
 #include <boost/math/tools/roots.hpp>
@@ -85,9 +87,7 @@ std::string map_boundary_csv_row(const MapBoundaryRow& b) {
   return out + "," + std::to_string(b.evaluations) + "\n";
 }
 
-namespace {
-
-numeric::SweepOptions sweep_options(const MapPlan& plan) {
+numeric::SweepOptions detail::sweep_options(const MapPlan& plan) {
   numeric::SweepOptions o;
   o.threads = plan.request().threads;
   o.block = plan.request().block;
@@ -96,12 +96,10 @@ numeric::SweepOptions sweep_options(const MapPlan& plan) {
   return o;
 }
 
-}  // namespace
-
 void run_map(const MapRequest& request, const std::function<void(const MapRow&)>& sink) {
   const MapPlan plan(request);
   const auto point = [&plan](long i) { return plan.point(i); };
-  const numeric::SweepOptions options = sweep_options(plan);
+  const numeric::SweepOptions options = detail::sweep_options(plan);
   long index = 0;
   numeric::run_sweep_streamed(plan.count(), point, options, [&](const numeric::SweepRow& row) {
     sink(MapRow{index, plan.values(index), row});
@@ -117,7 +115,7 @@ MapBoundaryRow solve_boundary(const MapPlan& plan, int along, long lower, long u
   b.x = plan.values(lower);
   const auto k = static_cast<std::size_t>(along);
   // s(t): one cold point at t on the line, the sweep's own row (numeric/sweep.hpp).
-  numeric::SweepOptions options = sweep_options(plan);
+  numeric::SweepOptions options = detail::sweep_options(plan);
   options.threads = 1;
   options.settle.step = 0;
   options.family = std::move(family);

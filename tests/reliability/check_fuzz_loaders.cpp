@@ -147,7 +147,9 @@ TEST(FuzzMeasuredCsv, EveryInputIsAcceptedSoundlyOrRefusedInOneLine) {
       ASSERT_GE(r.t.size(), 10u);
       for (std::size_t k = 0; k < r.t.size(); ++k) {
         EXPECT_TRUE(std::isfinite(r.t[k]));
-        if (k > 0) EXPECT_GT(r.t[k], r.t[k - 1]) << "accepted times not increasing:\n" << input;
+        if (k > 0) {
+          EXPECT_GT(r.t[k], r.t[k - 1]) << "accepted times not increasing:\n" << input;
+        }
       }
       ASSERT_EQ(r.theta_out.size(), r.t.size());
       for (double v : r.theta_out) EXPECT_TRUE(std::isfinite(v)) << input;

@@ -124,7 +124,9 @@ TEST(Soak, RandomValidParameterSetsFinishWithAStatusAndTheSimulatorsAgree) {
     const numeric::SimulationResult odeint = numeric::simulate_step_with_odeint(p, step, o);
     ++statuses[numeric::to_string(closed.status)];
     ASSERT_TRUE(finite(closed.final_state)) << label << ": returned a non-finite final state";
-    if (numeric::stopped_early(closed.status)) EXPECT_FALSE(closed.stop_reason.empty()) << label;
+    if (numeric::stopped_early(closed.status)) {
+      EXPECT_FALSE(closed.stop_reason.empty()) << label;
+    }
     bool grazed = false;
     for (const auto* r : {&closed, &odeint})
       for (const numeric::SimulationEvent& e : r->events) grazed = grazed || e.grazing;
@@ -164,9 +166,10 @@ TEST(Soak, RandomValidParameterSetsFinishWithAStatusAndTheSimulatorsAgree) {
     for (double v0 : {0.05, 1.0, 20.0}) {
       const numeric::DividingLinePoint d = numeric::dividing_line_point(*evaluator, v0);
       ++traced;
-      if (d.status != numeric::RecombinationStatus::NoRecombination)
+      if (d.status != numeric::RecombinationStatus::NoRecombination) {
         EXPECT_TRUE(std::isfinite(d.t) && d.t > 0 && std::isfinite(d.theta_o) && std::isfinite(d.dtheta_o))
             << label << ": v0 = " << v0 << " returned t = " << d.t;
+      }
     }
     if (HasFatalFailure()) return;
   }

@@ -137,8 +137,9 @@ TEST(Item03_SweepVerdicts, CaseVItselfIsValidatedAndRefusedPointsSayWhy) {
   std::getline(rows, first);
   EXPECT_NE(first.find(",limit_cycle,"), std::string::npos) << "K = 1 returned '" << first << "' instead of a limit cycle";
   for (std::string row; std::getline(rows, row);)
-    if (row.find(",limit_cycle,") == std::string::npos)
+    if (row.find(",limit_cycle,") == std::string::npos) {
       EXPECT_NE(r.err.find("sweep: V:K"), std::string::npos) << "row '" << row << "' has no reason on stderr: " << r.err;
+    }
 }
 
 TEST(Item04_Resolution, HugeStepIsRefusedWithTheReason) {
@@ -194,7 +195,9 @@ TEST(Item07_Scales, WhatCannotBeComputedIsRefusedAndStiffGainsAreComputed) {
     const std::string command = "simulate " + file.string() + " --step 0.62 --t-end 0.01";
     const CliRun r = run(command);
     EXPECT_TRUE(r.exit_code == 0 || r.exit_code == 3) << command << ": returned exit " << r.exit_code << " instead of 0 or 3: " << r.err;
-    if (r.exit_code == 3) EXPECT_NE(r.err.find("stopped early"), std::string::npos) << r.err;
+    if (r.exit_code == 3) {
+      EXPECT_NE(r.err.find("stopped early"), std::string::npos) << r.err;
+    }
   }
 }
 
