@@ -149,7 +149,7 @@ std::vector<MapBoundaryRow> solve_all(const MapPlan& plan, std::vector<Crossing>
     std::string list(reinterpret_cast<const char*>(crossings.data()), crossings.size() * sizeof(Crossing));
     t->broadcast(list);
     crossings.resize(list.size() / sizeof(Crossing));
-    std::memcpy(crossings.data(), list.data(), list.size());
+    if (!list.empty()) std::memcpy(crossings.data(), list.data(), list.size());  // no crossing: data() may be null
   }
   const long ranks = t ? t->size() : 1, rank = t ? t->rank() : 0, n = static_cast<long>(crossings.size());
   const long begin = n * rank / ranks, end = n * (rank + 1) / ranks;
