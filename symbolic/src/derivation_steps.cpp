@@ -46,21 +46,6 @@ std::vector<Pole> ordered_poles(const ex& denominator, const symbol& s, RadicalL
 }
 
 // Where a pole's residues are taken, each with its partner (the pair's other pole; 0 for a real pole).
-std::vector<std::pair<ex, ex>> pole_locations(const Pole& pole, const symbol& i) {
-  std::vector<std::pair<ex, ex>> locations;  // (p, partner)
-  switch (pole.kind) {
-    case Pole::Kind::Real: locations.push_back({pole.center, 0}); break;
-    case Pole::Kind::RealPair:
-      locations.push_back({pole.center + pole.half_width, pole.center - pole.half_width});
-      locations.push_back({pole.center - pole.half_width, pole.center + pole.half_width});
-      break;
-    case Pole::Kind::ComplexPair:
-      locations.push_back({pole.center + i * pole.half_width, pole.center - i * pole.half_width});
-      break;
-  }
-  return locations;
-}
-
 // What the residues add up, in order: the partial fractions (to compare with the transform) and the time terms.
 struct ResidueSums {
   std::vector<ExpTerm> terms;

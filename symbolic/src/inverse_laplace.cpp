@@ -125,6 +125,21 @@ std::vector<Pole> find_poles(const ex& denominator, const symbol& s, RadicalList
   return poles;
 }
 
+std::vector<std::pair<ex, ex>> pole_locations(const Pole& pole, const symbol& i) {
+  std::vector<std::pair<ex, ex>> locations;
+  switch (pole.kind) {
+    case Pole::Kind::Real: locations.push_back({pole.center, 0}); break;
+    case Pole::Kind::RealPair:
+      locations.push_back({pole.center + pole.half_width, pole.center - pole.half_width});
+      locations.push_back({pole.center - pole.half_width, pole.center + pole.half_width});
+      break;
+    case Pole::Kind::ComplexPair:
+      locations.push_back({pole.center + i * pole.half_width, pole.center - i * pole.half_width});
+      break;
+  }
+  return locations;
+}
+
 TimeFunction inverse_laplace(const ex& transform, const symbol& s, RadicalList& radicals, const std::string& radical_name,
                              const std::string& radical_role) {
   const ex fraction = numer_denom(normal(transform));
@@ -150,18 +165,8 @@ TimeFunction inverse_laplace(const ex& transform, const symbol& s, RadicalList& 
       throw std::logic_error("inverse_laplace: pole factor does not divide the denominator");
     const ex leading = pole.factor.coeff(s, pole.factor.degree(s));
 
-    std::vector<std::pair<ex, ex>> locations;  // (p, partner) with H = N / (lead^m (s-partner)^m rest)
-    switch (pole.kind) {
-      case Pole::Kind::Real: locations.push_back({pole.center, 0}); break;
-      case Pole::Kind::RealPair:
-        locations.push_back({pole.center + pole.half_width, pole.center - pole.half_width});
-        locations.push_back({pole.center - pole.half_width, pole.center + pole.half_width});
-        break;
-      case Pole::Kind::ComplexPair:
-        locations.push_back({pole.center + i.symbol * pole.half_width, pole.center - i.symbol * pole.half_width});
-        break;
-    }
-    for (const auto& [p, partner] : locations) {
+    // (p, partner) with H = N / (lead^m (s-partner)^m rest)
+    for (const auto& [p, partner] : pole_locations(pole, i.symbol)) {
       ex H = numerator / (pow(leading, m) * rest);
       if (pole.kind != Pole::Kind::Real) H = H / pow(s - partner, m);
       ex derivative = H;

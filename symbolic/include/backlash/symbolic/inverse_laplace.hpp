@@ -24,6 +24,7 @@
 #include <ginac/ginac.h>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace backlash::symbolic {
@@ -42,6 +43,12 @@ struct Pole {
 /// `radical_name`, `radical_name`_2, …) are appended to `radicals`.
 std::vector<Pole> find_poles(const GiNaC::ex& denominator, const GiNaC::symbol& s, RadicalList& radicals,
                              const std::string& radical_name, const std::string& radical_role);
+
+/// Where the residues are taken, as (p, partner) pairs: (center, 0) for a real pole; both roots
+/// of a real pair, each with the other as its partner (center ± half_width, the + root first);
+/// only the upper root center + i·half_width of a complex pair (its conjugate's residue is the
+/// conjugate: the two are folded into e^{αt}(P cos ωt + Q sin ωt)), `i` the imaginary unit's symbol.
+std::vector<std::pair<GiNaC::ex, GiNaC::ex>> pole_locations(const Pole& pole, const GiNaC::symbol& i);
 
 /// Exact inverse Laplace transform of a proper rational function of s.
 /// Throws std::domain_error for an improper function, an undecidable
