@@ -1,5 +1,6 @@
 // The event loop of the hybrid model with effects (effects_engine.hpp, docs/effects.md).
 #include "effects_engine.hpp"
+#include "rest_search.hpp"
 
 #include "backlash/numeric/effects_simulation.hpp"
 
@@ -399,16 +400,7 @@ bool Engine::rests_in_free_flight(const Mode& m, const Segment& segment, double 
   if (m.kind != ModeKind::Free) return false;
   const HybridState end = segment.state(remaining);
   if (std::max(std::fabs(end.dtheta_m), std::fabs(end.dtheta_L)) >= o_.rest_velocity) return false;
-  double lo = 0, hi = remaining;
-  for (int i = 0; i < 200 && hi - lo > 1e-12 * std::max(1.0, hi); ++i) {
-    const double mid = 0.5 * (lo + hi);
-    bool moving = false;
-    for (int k = 0; k <= 32 && !moving; ++k) {
-      const HybridState s = segment.state(mid + (remaining - mid) * k / 32.0);
-      moving = std::max(std::fabs(s.dtheta_m), std::fabs(s.dtheta_L)) >= o_.rest_velocity;
-    }
-    (moving ? lo : hi) = mid;
-  }
+  const double hi = detail::rest_time([&](double t) { return segment.state(t); }, remaining, o_.rest_velocity);
   const double t_end = t_ + remaining;
   t_ += hi;
   state_ = segment.state(hi);

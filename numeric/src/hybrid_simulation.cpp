@@ -5,6 +5,7 @@
 #include "backlash/numeric/scales.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
 #include "gap_events.hpp"
+#include "rest_search.hpp"
 
 #include <boost/math/tools/roots.hpp>
 
@@ -454,16 +455,7 @@ std::optional<std::string> ClosedFormRun::unresolved_return(const detail::GapEve
 // Rest: the event at the last time any velocity exceeded the tolerance (bisection on the
 // closed form), then the state at t_end.
 SimulationStatus ClosedFormRun::rest(const Flight& flight, double remaining, const HybridState& end) {
-  double lo = 0, hi = remaining;
-  for (int i = 0; i < 200 && hi - lo > 1e-12 * std::max(1.0, hi); ++i) {
-    const double mid = 0.5 * (lo + hi);
-    bool moving = false;
-    for (int k = 0; k <= 32 && !moving; ++k) {  // any motion left in [mid, remaining]?
-      const HybridState s = flight.at(mid + (remaining - mid) * k / 32.0);
-      moving = std::max(std::fabs(s.dtheta_m), std::fabs(s.dtheta_L)) >= o_.rest_velocity;
-    }
-    (moving ? lo : hi) = mid;
-  }
+  const double hi = detail::rest_time([&](double t) { return flight.at(t); }, remaining, o_.rest_velocity);
   const double t_end = t_ + remaining;
   t_ += hi;
   state_ = flight.at(hi);
