@@ -1,5 +1,5 @@
 // `backlash map` — design-space maps: limit cycles over several parameters at once
-// (api/map.hpp; docs/design.md, "Design-space maps").
+// (backlash/api/map.hpp, the map library map/; docs/design.md, "Design-space maps").
 //
 //   backlash map CASE --vary P=A:B:N [--vary Q=A:B:N]... [--sample grid|sobol|lhs --points N]
 //                [--threads T] [--step A] [--out DIR [--resume]] [--no-boundary] [--no-hdf5] [--json]

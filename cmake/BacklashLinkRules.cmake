@@ -5,6 +5,8 @@
 # Call it deferred (cmake_language(DEFER DIRECTORY ${CMAKE_SOURCE_DIR} ...)) so
 # that every target is defined when the closure is walked.  The closure is
 # written to REPORT (one entry per line) for the tests to inspect.
+include_guard(GLOBAL)
+
 function(backlash_link_closure target out_var)
   set(seen "")
   set(queue ${target})
@@ -57,4 +59,55 @@ function(backlash_forbid_links)
       endif()
     endforeach()
   endforeach()
+endfunction()
+
+# backlash_write_link_closures(directory)
+#
+# Writes, for every library target of the project outside tests/ (static, shared, object or
+# interface; not the Python extension modules), its link closure to directory/<target>.txt,
+# one entry a line: the target itself first, then every target and library it links,
+# directly or not, aliases (backlash::x) replaced by the targets they name.  directory/
+# libraries.txt lists the targets.  Called deferred from the top-level CMakeLists.txt, once
+# every target exists; tests/architecture/check_dependency_rules.cmake reads the files and
+# fails on a link the rules forbid.
+function(backlash_collect_libraries directory result_variable)
+  get_property(targets DIRECTORY ${directory} PROPERTY BUILDSYSTEM_TARGETS)
+  set(libraries)
+  foreach(target IN LISTS targets)
+    get_target_property(type ${target} TYPE)
+    if(type MATCHES "^(STATIC|SHARED|OBJECT|INTERFACE)_LIBRARY$")
+      list(APPEND libraries ${target})
+    endif()
+  endforeach()
+  get_property(subdirectories DIRECTORY ${directory} PROPERTY SUBDIRECTORIES)
+  foreach(subdirectory IN LISTS subdirectories)
+    if(NOT subdirectory STREQUAL "${CMAKE_SOURCE_DIR}/tests")
+      backlash_collect_libraries(${subdirectory} nested_libraries)
+      list(APPEND libraries ${nested_libraries})
+    endif()
+  endforeach()
+  set(${result_variable} ${libraries} PARENT_SCOPE)
+endfunction()
+
+function(backlash_write_link_closures directory)
+  backlash_collect_libraries(${CMAKE_SOURCE_DIR} libraries)
+  file(REMOVE_RECURSE ${directory})
+  foreach(library IN LISTS libraries)
+    backlash_link_closure(${library} closure)
+    set(resolved)
+    foreach(entry IN LISTS closure)
+      if(TARGET ${entry})
+        get_target_property(aliased ${entry} ALIASED_TARGET)
+        if(aliased)
+          set(entry ${aliased})
+        endif()
+      endif()
+      list(APPEND resolved ${entry})
+    endforeach()
+    list(REMOVE_DUPLICATES resolved)
+    string(REPLACE ";" "\n" lines "${resolved}")
+    file(WRITE ${directory}/${library}.txt "${lines}\n")
+  endforeach()
+  string(REPLACE ";" "\n" lines "${libraries}")
+  file(WRITE ${directory}/libraries.txt "${lines}\n")
 endfunction()

@@ -3,13 +3,13 @@
 #
 #   P/bin/backlash                              the CLI
 #   P/include/backlash/<part>/*.hpp             the headers (model numeric measurements
-#                                               discrepancy symbolic codegen generated api)
+#                                               discrepancy symbolic codegen generated api map)
 #   P/lib/libbacklash_<part>.a (.so with -DBACKLASH_SHARED=ON)
 #   P/lib/cmake/backlash/backlashConfig.cmake, backlashConfigVersion.cmake, backlashTargets*.cmake
 #                                               find_package(backlash) → backlash::model,
 #                                               ::numeric, ::measurements, ::discrepancy,
 #                                               ::symbolic, ::codegen, ::generated, ::api,
-#                                               ::api_derive
+#                                               ::api_derive, ::map, ::map_figures (::map_mpi)
 #   P/share/backlash/cases/*.toml               the thesis's cases  (model/data_dir.hpp: found
 #   P/share/backlash/errata/*.toml              the errata ledger    at run time from the
 #   P/share/backlash/data/*.toml                the thesis's numbers binary's own location)

@@ -12,8 +12,8 @@
 
 namespace {
 
-using backlash::reports::MapFigures;
-using backlash::reports::MapSensitivity;
+using backlash::map::figures::MapFigures;
+using backlash::map::figures::MapSensitivity;
 using std::numbers::pi;
 
 double ishigami(double x1, double x2, double x3) { return std::sin(x1) + 7 * std::pow(std::sin(x2), 2) + 0.1 * std::pow(x3, 4) * std::sin(x1); }

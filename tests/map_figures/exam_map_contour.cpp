@@ -13,9 +13,9 @@
 
 namespace {
 
-using backlash::reports::MapAxis;
-using backlash::reports::MapField;
-using backlash::reports::MapFigures;
+using backlash::map::figures::MapAxis;
+using backlash::map::figures::MapField;
+using backlash::map::figures::MapFigures;
 
 // A coordinate in bins: (u(value) − origin) / width, u the value or its log10.
 struct BinCoordinate {

@@ -21,9 +21,9 @@
 namespace {
 
 namespace fs = std::filesystem;
-using backlash::reports::MapAxis;
-using backlash::reports::MapBoundaryPoint;
-using backlash::reports::MapFigures;
+using backlash::map::figures::MapAxis;
+using backlash::map::figures::MapBoundaryPoint;
+using backlash::map::figures::MapFigures;
 
 std::string read(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
@@ -50,7 +50,7 @@ MapFigures disk_map() {
         const std::vector<double> x = {std::pow(10.0, u), y, K};
         const double r = std::hypot(u, (y - 0.5) * 2);
         if (i == 0 && j == 0) {
-          backlash::reports::MapPoint p = backlash::test::rest_point(index++, x);
+          backlash::map::figures::MapPoint p = backlash::test::rest_point(index++, x);
           p.status = "divergent";
           map.add(p);
         } else {
@@ -169,7 +169,7 @@ TEST(MapFiguresFiles, MapsWithoutAnswersOrWithoutABoundaryStillDraw) {
     std::int64_t index = 0;
     for (int a = 0; a < 3; ++a)
       for (int b = 0; b < 3; ++b) {
-        backlash::reports::MapPoint p = backlash::test::cycle_point(index++, {1 + a / 2.0, 0.1 + b / 10.0}, 0.02);
+        backlash::map::figures::MapPoint p = backlash::test::cycle_point(index++, {1 + a / 2.0, 0.1 + b / 10.0}, 0.02);
         p.status = status;
         map.add(p);
       }

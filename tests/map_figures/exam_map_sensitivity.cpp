@@ -19,9 +19,9 @@
 
 namespace {
 
-using backlash::reports::MapAxis;
-using backlash::reports::MapFigures;
-using backlash::reports::MapSensitivity;
+using backlash::map::figures::MapAxis;
+using backlash::map::figures::MapFigures;
+using backlash::map::figures::MapSensitivity;
 using std::numbers::pi;
 
 const char* const kNames[] = {"x1", "x2", "x3"};

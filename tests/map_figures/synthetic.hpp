@@ -2,7 +2,7 @@
 // from functions whose answers are known in closed form (no backlash physics involved).
 #pragma once
 
-#include "backlash/reports/map_figures.hpp"
+#include "backlash/map/figures.hpp"
 
 #include <cstdint>
 #include <limits>
@@ -15,8 +15,8 @@ namespace backlash::test {
 inline double uniform(std::mt19937_64& generator) { return static_cast<double>(generator() >> 11) * 0x1.0p-53; }
 
 /// A point with a limit cycle of swing `magnitude` (rad) at x.
-inline reports::MapPoint cycle_point(std::int64_t index, std::vector<double> x, double magnitude) {
-  reports::MapPoint p;
+inline map::figures::MapPoint cycle_point(std::int64_t index, std::vector<double> x, double magnitude) {
+  map::figures::MapPoint p;
   p.index = index;
   p.x = std::move(x);
   p.status = "limit_cycle";
@@ -28,8 +28,8 @@ inline reports::MapPoint cycle_point(std::int64_t index, std::vector<double> x, 
 }
 
 /// A point without a cycle at x.
-inline reports::MapPoint rest_point(std::int64_t index, std::vector<double> x) {
-  reports::MapPoint p;
+inline map::figures::MapPoint rest_point(std::int64_t index, std::vector<double> x) {
+  map::figures::MapPoint p;
   p.index = index;
   p.x = std::move(x);
   p.status = "none";

@@ -7,7 +7,8 @@
 #      the CMake package files;
 #   3. tests/package/consumer (find_package(backlash), case V's limit cycle through the
 #      facade and through backlash::numeric alone, a map's sensitivity ranking through
-#      backlash::map_figures alone) configures, builds and runs — without GiNaC mapped;
+#      backlash::map_figures alone, a map's points through backlash::map) configures, builds
+#      and runs — without GiNaC mapped;
 #   4. the README's C++ example, taken from README.md itself, builds and prints the
 #      output the README shows;
 #   5. the installed Python module imports and finds its data beside the prefix; the
@@ -57,7 +58,8 @@ foreach(file
     bin/backlash
     include/backlash/api/backlash.hpp include/backlash/api/derive.hpp include/backlash/model/case_spec.hpp
     include/backlash/numeric/limit_cycle.hpp include/backlash/generated/case_V.hpp
-    include/backlash/reports/map_figures.hpp include/backlash/reports/plot.hpp
+    include/backlash/map/map.hpp include/backlash/map/figures.hpp include/backlash/api/map.hpp
+    include/backlash/reports/plot.hpp
     lib/cmake/backlash/backlashConfig.cmake lib/cmake/backlash/backlashConfigVersion.cmake
     lib/cmake/backlash/backlashTargets.cmake
     share/backlash/cases/V.toml share/backlash/errata/ledger.toml share/backlash/data/thesis_cases.toml
@@ -134,6 +136,12 @@ endif()
 run(map_figures_only ${WORK_DIR}/consumer/map_figures_only)
 if(NOT map_figures_only STREQUAL "K 0.6667\nbacklash 0.1667\nginac mapped: no\n")
   fail("the map-figures consumer printed\n${map_figures_only}\ninstead of\nK 0.6667\nbacklash 0.1667\nginac mapped: no")
+endif()
+
+# a grid of 2 × 3 points over case V (backlash::map, through the facade's backlash/api/map.hpp)
+run(map_only ${WORK_DIR}/consumer/map_only)
+if(NOT map_only STREQUAL "6 points, x_K = 1.5, K 1.5\nginac mapped: no\n")
+  fail("the map consumer printed\n${map_only}\ninstead of\n6 points, x_K = 1.5, K 1.5\nginac mapped: no")
 endif()
 
 # 4. the README's C++ example and the output the README shows for it

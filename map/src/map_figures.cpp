@@ -1,8 +1,8 @@
-// Figures and summary of a design-space map (reports/map_figures.hpp): bins per pair and
+// Figures and summary of a design-space map (map/figures.hpp): bins per pair and
 // per axis filled as the points stream past, heat maps with the 1/2-contour of the cycle
 // fraction (marching squares) drawn by gnuplot through plot.hpp, and summary.md
 // (docs/map-figures.md).
-#include "backlash/reports/map_figures.hpp"
+#include "backlash/map/figures.hpp"
 
 #include "backlash/reports/plot.hpp"
 
@@ -17,7 +17,14 @@
 #include <stdexcept>
 #include <utility>
 
-namespace backlash::reports {
+namespace backlash::map::figures {
+
+// The figures are drawn with gnuplot through the plotting target (backlash/reports/plot.hpp).
+using reports::HeatMap;
+using reports::Label;
+using reports::Plot;
+using reports::render_figures;
+using reports::Series;
 
 namespace {
 
@@ -490,4 +497,4 @@ std::string MapFigures::write(const std::filesystem::path& directory) const {
   return failure;
 }
 
-}  // namespace backlash::reports
+}  // namespace backlash::map::figures

@@ -1,5 +1,5 @@
-// map_mpi.cpp — MapTransport over Boost.MPI (api/map_mpi.hpp).
-#include "backlash/api/map_mpi.hpp"
+// map_mpi.cpp — MapTransport over Boost.MPI (map/mpi.hpp).
+#include "backlash/map/mpi.hpp"
 
 #include <boost/mpi/collectives.hpp>
 #include <boost/mpi/communicator.hpp>
@@ -7,7 +7,7 @@
 
 #include <cstdlib>
 
-namespace backlash::api {
+namespace backlash::map {
 
 namespace {
 
@@ -40,4 +40,4 @@ std::unique_ptr<MapTransport> mpi_transport() {
   return std::make_unique<MpiTransport>();
 }
 
-}  // namespace backlash::api
+}  // namespace backlash::map

@@ -2,7 +2,7 @@
 // what points.bin holds until the end), and the HDF5 writer (map_hdf5.cpp).
 #pragma once
 
-#include "backlash/api/map.hpp"
+#include "backlash/map/map.hpp"
 
 #include <cstdint>
 #include <cstring>
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-namespace backlash::api::detail {
+namespace backlash::map::detail {
 
 /// The statuses a record stores as a code (status_of's texts; anything else is "other").
 inline const std::vector<std::string>& map_status_names() {
@@ -36,7 +36,7 @@ struct MapRecord {
 };
 
 inline void append_record(std::string& out, const MapRow& r) {
-  const std::int64_t head[2] = {r.index, map_status_code(status_of(r.row))};
+  const std::int64_t head[2] = {r.index, map_status_code(api::status_of(r.row))};
   out.append(reinterpret_cast<const char*>(head), sizeof head);
   const numeric::Parameters& p = r.row.point.parameters;
   const numeric::Effects& e = r.row.point.effects;
@@ -78,4 +78,4 @@ class MapHdf5 {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace backlash::api::detail
+}  // namespace backlash::map::detail

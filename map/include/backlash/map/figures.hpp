@@ -1,5 +1,6 @@
-// backlash/reports/map_figures.hpp — figures and summary of a design-space map
-// (`backlash map`): limit cycles over several parameters at once.
+// backlash/map/figures.hpp — figures and summary of a design-space map
+// (`backlash map`): limit cycles over several parameters at once.  Target backlash::map_figures:
+// no facade, no GiNaC, gnuplot at run time (backlash/reports/plot.hpp, target backlash::plot).
 //
 // A map varies d parameters (the names `sweep` knows — Jm Fm JL FL K backlash reference
 // JL_over_Jm FL_over_F — and the effects' parameters) over boxes [from, to], on a grid
@@ -34,7 +35,7 @@
 #include <string>
 #include <vector>
 
-namespace backlash::reports {
+namespace backlash::map::figures {
 
 /// One varied parameter of a map.
 struct MapAxis {
@@ -147,4 +148,4 @@ class MapFigures {
   double magnitude_min_ = 0, magnitude_max_ = 0, period_min_ = 0, period_max_ = 0;
 };
 
-}  // namespace backlash::reports
+}  // namespace backlash::map::figures

@@ -1,6 +1,6 @@
 // map_rows.cpp — a map's rows: computed in order (run_map), written as CSV, and the
-// cycle/no-cycle boundary solved along grid lines (api/map.hpp).
-#include "backlash/api/map.hpp"
+// cycle/no-cycle boundary solved along grid lines (map/map.hpp).
+#include "backlash/map/map.hpp"
 
 #include "map_output.hpp"
 
@@ -11,7 +11,7 @@
 #include <charconv>
 #include <cmath>
 
-namespace backlash::api {
+namespace backlash::map {
 
 namespace {
 
@@ -59,7 +59,7 @@ std::string map_csv_row(const MapRow& r) {
   for (const double v : {p.Jm, p.Fm, p.JL, p.FL, p.K, p.backlash, p.theta_R, e.coulomb_motor, e.coulomb_load,
                          e.restitution, e.saturation, e.mesh_stiffness, e.mesh_damping, e.delay, e.torque_offset})
     out += ',', append_number(out, v);
-  const std::string status = status_of(r.row);
+  const std::string status = api::status_of(r.row);
   const bool cycle = status == "limit_cycle";
   out += "," + status + ",";
   append_quoted(out, r.row.reason);
@@ -124,7 +124,7 @@ MapBoundaryRow solve_boundary(const MapPlan& plan, int along, long lower, long u
     ++b.evaluations;
     std::string status;
     numeric::run_sweep_streamed(1, [&](long) { return point; }, options,
-                                [&](const numeric::SweepRow& row) { status = status_of(row); });
+                                [&](const numeric::SweepRow& row) { status = api::status_of(row); });
     return status == "limit_cycle" ? -1.0 : 1.0;
   };
   double a = b.x[k], c = plan.values(upper)[k];
@@ -142,4 +142,4 @@ MapBoundaryRow solve_boundary(const MapPlan& plan, int along, long lower, long u
   return b;
 }
 
-}  // namespace backlash::api
+}  // namespace backlash::map

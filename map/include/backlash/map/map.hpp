@@ -1,12 +1,16 @@
-// backlash/api/map.hpp — design-space maps: limit cycles over several parameters at once, on
+// backlash/map/map.hpp — design-space maps: limit cycles over several parameters at once, on
 // one machine or many (MPI).  `backlash map` is this header (docs/design.md, "Design-space maps").
+// The map is a library of its own (map/, target backlash::map, no GiNaC) on top of the facade
+// (backlash/api/backlash.hpp: the case, BadInput, status_of); the facade's users reach it as
+// backlash/api/map.hpp, which names these in backlash::api.  Its figures: backlash/map/figures.hpp;
+// its MPI ranks: backlash/map/mpi.hpp.
 //
-//   #include "backlash/api/map.hpp"                         // target backlash::api (no GiNaC)
-//   backlash::api::MapRequest r;
+//   #include "backlash/map/map.hpp"                         // target backlash::map (no GiNaC)
+//   backlash::map::MapRequest r;
 //   r.target = "V";
-//   r.vary = {backlash::api::parse_vary("JL_over_Jm=0.25:4:40"), backlash::api::parse_vary("FL_over_F=0:1:40")};
-//   backlash::api::run_map(r, [](const backlash::api::MapRow& row) { ... });   // rows in index order
-//   backlash::api::write_map(r, {.out = "map-V"});                             // the files of `backlash map --out`
+//   r.vary = {backlash::map::parse_vary("JL_over_Jm=0.25:4:40"), backlash::map::parse_vary("FL_over_F=0:1:40")};
+//   backlash::map::run_map(r, [](const backlash::map::MapRow& row) { ... });   // rows in index order
+//   backlash::map::write_map(r, {.out = "map-V"});                             // the files of `backlash map --out`
 //
 // Each point is the case with the varied parameters set (the names `sweep` knows, api/backlash.hpp
 // SweepRequest::vary: Jm Fm JL FL K backlash reference, JL_over_Jm keeping Jm + JL, FL_over_F keeping
@@ -42,7 +46,7 @@
 #include <string>
 #include <vector>
 
-namespace backlash::api {
+namespace backlash::map {
 
 /// One varied parameter: --vary NAME=FROM:TO:N (N: grid values; ignored by sobol/lhs, which
 /// take the range only — give N = 1 or any N there).
@@ -52,7 +56,7 @@ struct MapAxis {
   long count = 1;
 };
 
-/// "JL_over_Jm=0.25:4:40" (or "NAME=FROM:TO" for sampled maps).  BadInput "vary" naming the text.
+/// "JL_over_Jm=0.25:4:40" (or "NAME=FROM:TO" for sampled maps).  api::BadInput "vary" naming the text.
 MapAxis parse_vary(const std::string& text);
 
 struct MapRequest {
@@ -67,14 +71,14 @@ struct MapRequest {
   std::uint64_t seed = 13;         ///< lhs: the permutations' key
 };
 
-/// A request checked and its points made on demand.  BadInput "vary" / "sample" / "points" /
+/// A request checked and its points made on demand.  api::BadInput "vary" / "sample" / "points" /
 /// "threads" / "step" / "block" naming the problem (a parameter range outside its physical range
 /// is refused here, before any point is computed); model::CaseFileError for the case.
 class MapPlan {
  public:
   explicit MapPlan(const MapRequest& request);
   const MapRequest& request() const { return request_; }
-  const Case& source() const { return case_; }
+  const api::Case& source() const { return case_; }
   long count() const { return count_; }
   /// The varied values of point `index` (in the order of request().vary).
   std::vector<double> values(long index) const;
@@ -93,7 +97,7 @@ class MapPlan {
  private:
   void apply(const std::string& name, double x, numeric::Parameters& p, numeric::Effects& e) const;
   MapRequest request_;
-  Case case_;
+  api::Case case_;
   numeric::Parameters base_;
   numeric::Effects base_effects_;
   long count_ = 0;
@@ -104,7 +108,7 @@ class MapPlan {
 struct MapRow {
   long index = 0;
   std::vector<double> x;  ///< the varied values
-  numeric::SweepRow row;  ///< parameters, status (status_of(row)), reason, branches, cycle, settle
+  numeric::SweepRow row;  ///< parameters, status (api::status_of(row)), reason, branches, cycle, settle
 };
 
 /// The CSV of `backlash map` (points.csv): its header, and one row (both end in '\n').
@@ -139,7 +143,7 @@ void run_map(const MapRequest& request, const std::function<void(const MapRow&)>
 MapBoundaryRow solve_boundary(const MapPlan& plan, int along, long lower, long upper, bool cycle_at_lower,
                               std::shared_ptr<const numeric::ValidatedParametricFamily> family = nullptr);
 
-/// How MPI ranks talk (api/src/map_mpi.cpp makes one over Boost.MPI; nothing else depends on MPI).
+/// How MPI ranks talk (map/src/map_mpi.cpp makes one over Boost.MPI; nothing else depends on MPI).
 class MapTransport {
  public:
   virtual ~MapTransport() = default;
@@ -155,7 +159,7 @@ struct MapOutput {
   std::filesystem::path out;       ///< the folder (replaced atomically; reports/output_directory.hpp rules)
   bool resume = false;             ///< continue an interrupted run of the same request
   bool hdf5 = true;                ///< map.h5 beside points.csv
-  bool figures = true;             ///< figures/ and summary.md (reports/map_figures.hpp)
+  bool figures = true;             ///< figures/ and summary.md (map/figures.hpp)
   long stop_after = -1;            ///< >= 0: stop (interrupted) once this many points are written (tests)
   MapTransport* transport = nullptr;  ///< MPI: the ranks (null: this process alone)
   std::function<bool()> interrupted{};  ///< polled between blocks: true stops the run (a signal)
@@ -177,9 +181,9 @@ struct MapSummary {
 /// renamed into place at the end.  Interrupted (stop_after, interrupted()), the partial folder
 /// keeps every completed block and a checkpoint; `resume` continues from there (the partial block
 /// recomputed) and the final files are byte-identical to an uninterrupted run's.  Every rank of a
-/// transport calls it; rank 0 writes.  BadInput for a bad request or --out, before anything is written.
+/// transport calls it; rank 0 writes.  api::BadInput for a bad request or --out, before anything is written.
 MapSummary write_map(const MapRequest& request, const MapOutput& output);
 /// Where write_map keeps an unfinished map of --out `out`: ".OUT.map-partial" beside it.
 std::filesystem::path map_partial_folder(const std::filesystem::path& out);
 
-}  // namespace backlash::api
+}  // namespace backlash::map

@@ -1,14 +1,12 @@
 // map_finish.cpp — the end of `backlash map --out DIR`: map.h5, the figures and the statuses
 // from points.bin in one pass, the cycle/no-cycle boundary solved over every rank and thread,
-// boundary.csv, map.json, and the partial folder renamed into place (api/map.hpp).
+// boundary.csv, map.json, and the partial folder renamed into place (map/map.hpp).
 #include "map_output.hpp"
 #include "map_store.hpp"
 
 #include "backlash/numeric/validated_family.hpp"
 
-#ifdef BACKLASH_HAVE_MAP_FIGURES
-#include "backlash/reports/map_figures.hpp"
-#endif
+#include "backlash/map/figures.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -18,19 +16,18 @@
 #include <optional>
 #include <thread>
 
-namespace backlash::api::detail {
+namespace backlash::map::detail {
 
 namespace fs = std::filesystem;
 
 namespace {
 
-// The one place the map meets its figures (reports/map_figures.hpp).
+// The one place the map meets its figures (map/figures.hpp).
 class Figures {
  public:
   Figures(const MapPlan& plan, bool wanted) {
-#ifdef BACKLASH_HAVE_MAP_FIGURES
     if (!wanted) return;
-    std::vector<reports::MapAxis> axes;
+    std::vector<figures::MapAxis> axes;
     for (const MapAxis& a : plan.request().vary)
       axes.push_back({a.name, a.from, a.to, plan.request().sample == "grid" ? static_cast<int>(a.count) : 40, false});
     try {
@@ -38,45 +35,25 @@ class Figures {
     } catch (const std::exception& e) {  // axes it cannot bin (e.g. from = to when sampled): no figures, the rest written
       note_ = std::string("figures not drawn: ") + e.what();
     }
-#else
-    (void)plan, (void)wanted;
-#endif
   }
   void add(const MapRecord& r, std::size_t d) {
-#ifdef BACKLASH_HAVE_MAP_FIGURES
     if (!figures_) return;
-    reports::MapPoint p;
+    figures::MapPoint p;
     p.index = r.index;
     p.x.assign(r.values.begin(), r.values.begin() + static_cast<long>(d));
     p.status = map_status_names()[static_cast<std::size_t>(r.status)];
     p.peak_to_peak = r.values[d + 15], p.period = r.values[d + 17], p.multiplier = r.values[d + 19];
     p.settle_time = r.values[d + 20];
     figures_->add(p);
-#else
-    (void)r, (void)d;
-#endif
   }
   void add_boundary(const MapBoundaryRow& b) {
-#ifdef BACKLASH_HAVE_MAP_FIGURES
     if (figures_) figures_->add_boundary({b.x, b.along});
-#else
-    (void)b;
-#endif
   }
-  std::string write(const fs::path& folder) const {
-#ifdef BACKLASH_HAVE_MAP_FIGURES
-    return figures_ ? figures_->write(folder) : note_;
-#else
-    (void)folder;
-    return "figures not built (this build has no backlash_map_figures)";
-#endif
-  }
+  std::string write(const fs::path& folder) const { return figures_ ? figures_->write(folder) : note_; }
 
  private:
-#ifdef BACKLASH_HAVE_MAP_FIGURES
-  std::optional<reports::MapFigures> figures_;
+  std::optional<figures::MapFigures> figures_;
   std::string note_;
-#endif
 };
 
 struct Crossing {
@@ -244,4 +221,4 @@ void finish_map(const MapPlan& plan, const MapOutput& output,
   commit(staging, output.out);
 }
 
-}  // namespace backlash::api::detail
+}  // namespace backlash::map::detail

@@ -2,16 +2,16 @@
 // folder's row writer and checkpoint, and the final files.
 #pragma once
 
-#include "backlash/api/map.hpp"
+#include "backlash/map/map.hpp"
 
-#include "format.hpp"
+#include "map_text.hpp"
 
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <string>
 
-namespace backlash::api::detail {
+namespace backlash::map::detail {
 
 /// A stop asked for (a signal, or MapOutput::stop_after): the partial folder stays, resumable.
 struct Interrupted {};
@@ -61,4 +61,4 @@ class RowWriter {
 void finish_map(const MapPlan& plan, const MapOutput& output,
                 const std::shared_ptr<const numeric::ValidatedParametricFamily>& family, MapSummary& summary);
 
-}  // namespace backlash::api::detail
+}  // namespace backlash::map::detail

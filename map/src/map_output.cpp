@@ -1,8 +1,8 @@
 // map_output.cpp — `backlash map --out DIR`: the rows streamed into a partial folder with a
 // checkpoint at every block, on one process or over MPI ranks (MapTransport), then the final
-// files (HDF5, boundary, figures) and the atomic rename (api/map.hpp; docs/design.md,
+// files (HDF5, boundary, figures) and the atomic rename (map/map.hpp; docs/design.md,
 // "Design-space maps").
-#include "backlash/api/map.hpp"
+#include "backlash/map/map.hpp"
 
 #include "map_output.hpp"
 #include "map_store.hpp"
@@ -13,7 +13,9 @@
 #include <fstream>
 #include <sstream>
 
-namespace backlash::api {
+namespace backlash::map {
+
+using api::BadInput;
 
 namespace fs = std::filesystem;
 using detail::Interrupted;
@@ -250,4 +252,4 @@ MapSummary write_map(const MapRequest& request, const MapOutput& output) {
   return summary;
 }
 
-}  // namespace backlash::api
+}  // namespace backlash::map

@@ -7,7 +7,7 @@
 
 #include <stdexcept>
 
-namespace backlash::api::detail {
+namespace backlash::map::detail {
 
 namespace {
 
@@ -146,4 +146,4 @@ void MapHdf5::close() {
   checked(status, "close the file", 0);
 }
 
-}  // namespace backlash::api::detail
+}  // namespace backlash::map::detail

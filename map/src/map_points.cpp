@@ -1,8 +1,8 @@
-// map_points.cpp — the points of a design-space map (api/map.hpp): the request checked, grid,
+// map_points.cpp — the points of a design-space map (map/map.hpp): the request checked, grid,
 // Sobol and Latin-hypercube points made on demand from their index.
-#include "backlash/api/map.hpp"
+#include "backlash/map/map.hpp"
 
-#include "format.hpp"
+#include "map_text.hpp"
 
 #include <boost/random/sobol.hpp>
 
@@ -11,7 +11,9 @@
 #include <cmath>
 #include <set>
 
-namespace backlash::api {
+namespace backlash::map {
+
+using api::BadInput;
 
 namespace {
 
@@ -94,7 +96,7 @@ MapAxis parse_vary(const std::string& text) {
   return axis;
 }
 
-MapPlan::MapPlan(const MapRequest& request) : request_(request), case_(Case::load(request.target)) {
+MapPlan::MapPlan(const MapRequest& request) : request_(request), case_(api::Case::load(request.target)) {
   const MapRequest& r = request_;
   if (r.vary.empty() || r.vary.size() > 8) throw BadInput("vary", "give 1 to 8 --vary NAME=FROM:TO:N");
   std::set<std::string> seen;
@@ -232,4 +234,4 @@ numeric::SweepPoint MapPlan::point_at(long index, int axis, double value) const 
   return point;
 }
 
-}  // namespace backlash::api
+}  // namespace backlash::map
