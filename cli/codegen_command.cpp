@@ -2,10 +2,11 @@
 // header for a case (case_<ID>.hpp, depends only on <cmath>) and the LaTeX of
 // its expressions (case_<ID>.tex) into DIR.  CASE = I…VIII or a case file.
 #include "commands.hpp"
-#include "output_files.hpp"
 
 #include "backlash/api/backlash.hpp"
 #include "backlash/codegen/emit.hpp"
+#include "backlash/output/atomic_file.hpp"
+#include "backlash/output/target.hpp"
 
 #include <iostream>
 #include <memory>
@@ -22,10 +23,9 @@ struct CodegenOptions {
 void run_codegen(const CodegenOptions& options) {
   if (options.out.empty()) throw UsageError("codegen: --out DIR is required");
   const std::filesystem::path out(options.out);
-  if (std::filesystem::exists(out) && !std::filesystem::is_directory(out))
-    throw UsageError("codegen: --out " + options.out + " exists and is not a folder");
+  output::check_target(out, output::Target::file_folder);
   const api::Case source = api::load(options.case_name);  // the one route to a case
-  OutputFiles files;
+  output::OutputFiles files;
   std::vector<std::filesystem::path> names;
   for (auto& file : codegen::emit_case_files(source.spec())) {
     names.push_back(out / file.relative);

@@ -8,7 +8,8 @@
 #include "flags.hpp"
 
 #include "backlash/api/backlash.hpp"
-#include "backlash/reports/output_directory.hpp"
+#include "backlash/output/staged_directory.hpp"
+#include "backlash/output/target.hpp"
 
 #include <filesystem>
 #include <memory>
@@ -39,13 +40,13 @@ std::string file_name(const std::string& path) { return std::filesystem::path(pa
 void run_discrepancy(const DiscrepancyOptions& o) {
   const api::Case model = api::load(o.model);
   api::DiscrepancyRequest request = request_of(o);
-  if (!o.out.empty()) reports::check_output_target(o.out);
+  if (!o.out.empty()) output::check_target(o.out, output::Target::folder);
   const measurements::MeasuredRecord data = api::read_record(o.data);
   if (o.validate) request.validation = api::read_record(*o.validate);
   const api::Discrepancy found = api::discrepancy(model, data, request);
   const std::string validation_name = o.validate ? file_name(*o.validate) : "";
   if (!o.out.empty()) {
-    reports::StagedDirectory staged(o.out);
+    output::StagedDirectory staged(o.out);
     for (const auto& [name, content] : found.files(file_name(o.data), validation_name)) staged.write(name, content);
     staged.commit();
   }

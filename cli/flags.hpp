@@ -5,9 +5,9 @@
 
 #include "commands.hpp"
 
-#include <cerrno>
+#include "backlash/output/text.hpp"
+
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -15,28 +15,27 @@
 
 namespace backlash::cli {
 
-/// A finite number, or UsageError naming the flag and what is wrong: not a number at all, or
-/// one double precision cannot hold (beyond ±1.8e308, or nonzero below 2.2e-308 in size, where
-/// it keeps fewer digits — use 0 or a larger value).
+/// A finite number (backlash/output/text.hpp: the whole text, spaces and tabs around it
+/// aside, as one decimal), or UsageError naming the flag and what is wrong: not a number at
+/// all, or one double precision cannot hold (beyond ±1.8e308, or nonzero below 2.2e-308 in
+/// size, where it keeps fewer digits — use 0 or a larger value).
 inline double parse_number(const std::string& text, const std::string& flag) {
   const auto first = text.find_first_not_of(" \t");
   if (first == std::string::npos) throw UsageError(flag + ": empty value");
   const std::string trimmed = text.substr(first, text.find_last_not_of(" \t") - first + 1);
-  const char* begin = trimmed.c_str();
-  char* end = nullptr;
-  errno = 0;
-  const double value = std::strtod(begin, &end);
-  const int range = errno;
-  if (end == begin || *end != '\0') throw UsageError(flag + ": '" + text + "' is not a number");
-  if (std::isnan(value) || (std::isinf(value) && range != ERANGE)) throw UsageError(flag + ": '" + text + "' is not finite");
-  if (range == ERANGE && std::isinf(value))
-    throw UsageError(flag + ": '" + text + "' is too large for double precision (beyond 1.8e308)");
-  if (value != 0 && !std::isnormal(value))
-    throw UsageError(flag + ": '" + text + "' is too small for double precision (nonzero below 2.2e-308 in size); "
-                     "use 0 or a larger value");
-  if (range == ERANGE && value == 0)
-    throw UsageError(flag + ": '" + text + "' is too small for double precision (nonzero below 2.2e-308 in size); "
-                     "use 0 or a larger value");
+  const std::string too_small = flag + ": '" + text + "' is too small for double precision (nonzero below 2.2e-308 in "
+                                "size); use 0 or a larger value";
+  double value = 0;
+  switch (output::read_number(trimmed, value)) {
+    case output::NumberText::ok: break;
+    case output::NumberText::empty:
+    case output::NumberText::not_a_number: throw UsageError(flag + ": '" + text + "' is not a number");
+    case output::NumberText::not_finite: throw UsageError(flag + ": '" + text + "' is not finite");
+    case output::NumberText::too_large:
+      throw UsageError(flag + ": '" + text + "' is too large for double precision (beyond 1.8e308)");
+    case output::NumberText::too_small: throw UsageError(too_small);
+  }
+  if (value != 0 && !std::isnormal(value)) throw UsageError(too_small);
   return value;
 }
 

@@ -3,7 +3,8 @@
 // Every subcommand registers itself (cli/commands.hpp).  Errors become one line
 // on stderr, "backlash: error: <what>", and the exit code tells their kind:
 //   0  success, and --help (CLI11 prints it through app.exit)
-//   2  bad usage or bad input (CLI11 parse errors, UsageError, and what the facade calls bad
+//   2  bad usage or bad input (CLI11 parse errors, UsageError, a bad --out target (output::OutputError
+//      of kind bad_target; a failed write is 1), and what the facade calls bad
 //      input, api::is_bad_input: its BadInput named by the flag, CaseFileError, MeasuredDataError)
 //   1  any other failure
 //   3  a simulation stopped before its end time (chattering, event cap, non-finite,
@@ -13,7 +14,7 @@
 #include "commands.hpp"
 
 #include "backlash/api/backlash.hpp"
-#include "backlash/reports/output_directory.hpp"
+#include "backlash/output/output_error.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -80,8 +81,8 @@ int main(int argument_count, char** arguments) {
     return report_error(usage_error.what(), exit_code_for_bad_input);
   } catch (const backlash::api::BadInput& bad_input) {
     return report_error(flag_message(bad_input), exit_code_for_bad_input);
-  } catch (const backlash::reports::BadInput& bad_output) {
-    return report_error(bad_output.what(), exit_code_for_bad_input);
+  } catch (const backlash::output::OutputError& output_error) {  // a bad --out (2) or a failed write (1)
+    return report_error(output_error.what(), output_error.exit_code());
   } catch (const std::exception& error) {  // CaseFileError, MeasuredDataError: bad input too
     return report_error(error.what(), backlash::api::is_bad_input(error) ? exit_code_for_bad_input : exit_code_for_failure);
   }

@@ -7,7 +7,6 @@
 // appears all at once (or not at all).
 #include "commands.hpp"
 
-#include "backlash/reports/output_directory.hpp"
 #include "backlash/reports/report.hpp"
 
 #include <chrono>
@@ -29,7 +28,7 @@ void run_report(const ReportCommandOptions& options) {
   reports::ReportOptions report_options;
   report_options.out = options.out;
   report_options.pdf = !options.no_pdf;
-  const reports::ReportResult result = reports::write_report(report_options);  // reports::BadInput: exit 2 (main.cpp)
+  const reports::ReportResult result = reports::write_report(report_options);  // a bad --out: OutputError, exit 2 (main.cpp)
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   char timing[32];
   std::snprintf(timing, sizeof timing, "%.2f", seconds);

@@ -12,9 +12,9 @@
 // stderr when it is a terminal (--no-progress turns it off).
 #include "commands.hpp"
 #include "flags.hpp"
-#include "output_files.hpp"
 
 #include "backlash/api/backlash.hpp"
+#include "backlash/output/atomic_file.hpp"
 
 #include <unistd.h>
 
@@ -78,8 +78,8 @@ api::SweepRequest request_of(const SweepOptions& o) {
 void run_sweep_command(const SweepOptions& o) {
   const api::SweepRequest request = request_of(o);
   // The target is checked before any work; rows are streamed to it (or to stdout) as they come.
-  std::unique_ptr<AtomicFile> file;
-  if (!o.out.empty()) file = std::make_unique<AtomicFile>(std::filesystem::path(o.out));
+  std::unique_ptr<output::AtomicFile> file;
+  if (!o.out.empty()) file = std::make_unique<output::AtomicFile>(std::filesystem::path(o.out));
   NoCycleNotes notes;
   const api::Sweep sweep = api::sweep(
       request, [&](std::string_view text) { file ? file->write(text) : print(text); },

@@ -8,6 +8,7 @@
 #include "backlash/api/backlash.hpp"
 
 #include "backlash/measurements/measured_record.hpp"
+#include "backlash/output/text.hpp"
 
 #include <algorithm>
 #include <array>
@@ -19,24 +20,15 @@ namespace backlash::api {
 
 namespace {
 
+using output::toml_string;  // a TOML basic string (no control characters survive)
+
 std::string one_line(std::string text) {
   std::replace(text.begin(), text.end(), '\n', ' ');
   std::replace(text.begin(), text.end(), '\r', ' ');
   return text;
 }
 
-/// A TOML basic string holding `text` (no control characters survive).
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) continue;
-    out += c;
-  }
-  return out + "\"";
-}
-
-std::string exact(const model::Rational& value) { return quoted(model::to_string(value)); }
+std::string exact(const model::Rational& value) { return toml_string(model::to_string(value)); }
 
 /// The facade's parameter names and the case file's keys they stand for.
 struct ParameterKey {
@@ -137,31 +129,31 @@ Case Case::from_texts(const std::vector<std::pair<std::string, std::string>>& pa
 
   // Every value as a TOML string: the reader parses numbers in strings exactly ("0.3" is 3/10).
   std::ostringstream toml;
-  toml << "name = " << quoted(name) << "\n";
+  toml << "name = " << toml_string(name) << "\n";
   for (const char* key : {"measured_at", "K", "backlash", "reference"})
-    if (const std::string* v = value(key)) toml << key << " = " << quoted(*v) << "\n";
+    if (const std::string* v = value(key)) toml << key << " = " << toml_string(*v) << "\n";
   for (const auto& [table, inertia, friction] :
        {std::tuple{"motor", "Jm", "Fm"}, std::tuple{"load", "JL", "FL"}}) {
     toml << "[" << table << "]\n";
-    if (const std::string* v = value(inertia)) toml << "J = " << quoted(*v) << "\n";
-    if (const std::string* v = value(friction)) toml << "F = " << quoted(*v) << "\n";
+    if (const std::string* v = value(inertia)) toml << "J = " << toml_string(*v) << "\n";
+    if (const std::string* v = value(friction)) toml << "F = " << toml_string(*v) << "\n";
   }
   if (value("experiment") || value("step") || value("t_end") || value("drive_gain")) {
     toml << "[experiment]\n";
-    if (const std::string* v = value("experiment")) toml << "kind = " << quoted(*v) << "\n";
+    if (const std::string* v = value("experiment")) toml << "kind = " << toml_string(*v) << "\n";
     for (const char* key : {"step", "t_end", "drive_gain"})
-      if (const std::string* v = value(key)) toml << key << " = " << quoted(*v) << "\n";
+      if (const std::string* v = value(key)) toml << key << " = " << toml_string(*v) << "\n";
   }
   const bool compliance = value("stiffness") || value("damping");
   std::ostringstream effects;
   for (const char* key : {"coulomb_motor", "coulomb_load", "restitution", "saturation", "delay", "torque_offset"})
-    if (const std::string* v = value(key)) effects << key << " = " << quoted(*v) << "\n";
+    if (const std::string* v = value(key)) effects << key << " = " << toml_string(*v) << "\n";
   if (compliance) {
     effects << "compliance = {";
     const char* separator = " ";
     for (const char* key : {"stiffness", "damping"})
       if (const std::string* v = value(key)) {
-        effects << separator << key << " = " << quoted(*v);
+        effects << separator << key << " = " << toml_string(*v);
         separator = ", ";
       }
     effects << " }\n";
@@ -207,7 +199,7 @@ Case Case::from_parameters(const CaseParameters& p) {
 std::string Case::case_file() const {
   const model::CaseSpec& s = spec_;
   std::ostringstream out;
-  out << "name = " << quoted(s.name) << "\n";
+  out << "name = " << toml_string(s.name) << "\n";
   out << "measured_at = \"" << model::to_string(s.measured_at) << "\"\n";
   out << "K = " << exact(s.K) << "\n";
   out << "backlash = " << exact(s.backlash) << "\n";
@@ -239,7 +231,7 @@ std::string Case::case_file() const {
   }
   if (!s.fit_free.empty()) {
     out << "[fit]\nfree = [";
-    for (std::size_t i = 0; i < s.fit_free.size(); ++i) out << (i ? ", " : "") << quoted(s.fit_free[i]);
+    for (std::size_t i = 0; i < s.fit_free.size(); ++i) out << (i ? ", " : "") << toml_string(s.fit_free[i]);
     out << "]\n";
   }
   return out.str();

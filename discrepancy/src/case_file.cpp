@@ -18,26 +18,16 @@ std::string decimal(double value) {
   return text;
 }
 
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) continue;  // no control characters in a one-line string
-    out += c;
-  }
-  return out + "\"";
-}
-
 // The original exact value when the fit kept it, else the fitted decimal.
 std::string exact_or(const model::Rational& original, double value) {
-  return model::to_double(original) == value ? quoted(model::to_string(original)) : decimal(value);
+  return model::to_double(original) == value ? toml_string(model::to_string(original)) : decimal(value);
 }
 
 }  // namespace detail
 
 using detail::decimal;
 using detail::exact_or;
-using detail::quoted;
+using detail::toml_string;
 
 std::string corrected_case_file(const model::CaseSpec& spec, const DiscrepancyResult& result, double step) {
   std::ostringstream out;
@@ -51,7 +41,7 @@ std::string corrected_case_file(const model::CaseSpec& spec, const DiscrepancyRe
       << " after (noise " << result.noise << ").\n";
   const numeric::Parameters& p = result.parameters;
   const numeric::Effects& e = result.corrected_effects;
-  out << "name = " << quoted(spec.name + " (corrected)") << "\n";
+  out << "name = " << toml_string(spec.name + " (corrected)") << "\n";
   out << "measured_at = \"" << model::to_string(spec.measured_at) << "\"\n";
   out << "K = " << exact_or(spec.K, p.K) << "\n";
   out << "backlash = " << exact_or(spec.backlash, p.backlash) << "\n";
@@ -59,10 +49,10 @@ std::string corrected_case_file(const model::CaseSpec& spec, const DiscrepancyRe
   out << "[motor]\nJ = " << exact_or(spec.Jm, p.Jm) << "\nF = " << exact_or(spec.Fm, p.Fm) << "\n\n";
   out << "[load]\nJ = " << exact_or(spec.JL, p.JL) << "\nF = " << exact_or(spec.FL, p.FL) << "\n\n";
   out << "[experiment]\nstep = "
-      << (spec.experiment && model::to_double(spec.experiment->step) == step ? quoted(model::to_string(spec.experiment->step))
+      << (spec.experiment && model::to_double(spec.experiment->step) == step ? toml_string(model::to_string(spec.experiment->step))
                                                                                : decimal(step))
       << "\n";
-  if (spec.experiment && spec.experiment->t_end) out << "t_end = " << quoted(model::to_string(*spec.experiment->t_end)) << "\n";
+  if (spec.experiment && spec.experiment->t_end) out << "t_end = " << toml_string(model::to_string(*spec.experiment->t_end)) << "\n";
   if (!e.any()) return out.str();
   const model::Effects& m = spec.effects;
   out << "\n[effects]\n";
@@ -75,8 +65,8 @@ std::string corrected_case_file(const model::CaseSpec& spec, const DiscrepancyRe
     const bool same = m.compliance && model::to_double(m.compliance->stiffness) == e.mesh_stiffness &&
                       model::to_double(m.compliance->damping) == e.mesh_damping;
     out << "compliance = { stiffness = "
-        << (same ? quoted(model::to_string(m.compliance->stiffness)) : decimal(e.mesh_stiffness))
-        << ", damping = " << (same ? quoted(model::to_string(m.compliance->damping)) : decimal(e.mesh_damping)) << " }\n";
+        << (same ? toml_string(model::to_string(m.compliance->stiffness)) : decimal(e.mesh_stiffness))
+        << ", damping = " << (same ? toml_string(model::to_string(m.compliance->damping)) : decimal(e.mesh_damping)) << " }\n";
   }
   if (e.delayed()) out << "delay = " << exact_or(m.delay, e.delay) << "\n";
   if (e.torque_offset != 0) out << "torque_offset = " << exact_or(m.torque_offset, e.torque_offset) << "\n";

@@ -20,7 +20,7 @@ namespace {
 
 using detail::decimal;
 using detail::exact_or;
-using detail::quoted;
+using detail::toml_string;
 
 using detail::Band;
 using detail::Series;
@@ -155,18 +155,18 @@ std::string drive_corrected_case_file(const model::CaseSpec& spec, const DriveDi
   out << "# Torque RMS of the inverse dynamics: " << r.rms_before << " (best nominal model) -> " << r.rms_after << ".\n";
   const numeric::Parameters& p = r.parameters;
   const numeric::Effects& e = r.corrected_effects;
-  out << "name = " << quoted(spec.name + " (corrected)") << "\n";
+  out << "name = " << toml_string(spec.name + " (corrected)") << "\n";
   out << "measured_at = \"" << model::to_string(spec.measured_at) << "\"\n";
-  out << "K = " << quoted(model::to_string(spec.K)) << "\n";
+  out << "K = " << toml_string(model::to_string(spec.K)) << "\n";
   out << "backlash = 0\n";
-  out << "reference = " << quoted(model::to_string(spec.reference)) << "\n\n";
+  out << "reference = " << toml_string(model::to_string(spec.reference)) << "\n\n";
   out << "[motor]\nJ = " << exact_or(spec.Jm, p.Jm) << "\nF = " << exact_or(spec.Fm, p.Fm) << "\n\n";
   out << "[load]\nJ = " << exact_or(spec.JL, p.JL) << "\nF = " << exact_or(spec.FL, p.FL) << "\n\n";
-  out << "[experiment]\nkind = \"drive\"\ndrive_gain = " << quoted(model::to_string(spec.experiment->drive_gain)) << "\n";
-  if (spec.experiment->t_end) out << "t_end = " << quoted(model::to_string(*spec.experiment->t_end)) << "\n";
+  out << "[experiment]\nkind = \"drive\"\ndrive_gain = " << toml_string(model::to_string(spec.experiment->drive_gain)) << "\n";
+  if (spec.experiment->t_end) out << "t_end = " << toml_string(model::to_string(*spec.experiment->t_end)) << "\n";
   if (!spec.fit_free.empty()) {
     out << "\n[fit]\nfree = [";
-    for (std::size_t i = 0; i < spec.fit_free.size(); ++i) out << (i ? ", " : "") << quoted(spec.fit_free[i]);
+    for (std::size_t i = 0; i < spec.fit_free.size(); ++i) out << (i ? ", " : "") << toml_string(spec.fit_free[i]);
     out << "]\n";
   }
   if (!e.any()) return out.str();

@@ -3,13 +3,14 @@
 // checked over windows restarted from the measured state.
 #include "backlash/discrepancy/measured_drive.hpp"
 
+#include "quiet_ceres.hpp"
+
 #include "backlash/measurements/inverse_dynamics_signals.hpp"
 #include "backlash/numeric/measured_drive.hpp"
 
 #include <Eigen/Dense>
 #include <boost/math/tools/minima.hpp>
 #include <ceres/ceres.h>
-#include <glog/logging.h>
 
 #include <algorithm>
 #include <chrono>
@@ -503,14 +504,6 @@ struct TorqueCost final : ceres::CostFunction {
   }
 };
 
-void quiet_ceres() {
-  static const bool once = [] {
-    FLAGS_minloglevel = google::GLOG_FATAL;
-    return true;
-  }();
-  (void)once;
-}
-
 // Polishes a whole-record fit with Levenberg–Marquardt (all free parameters together) and
 // returns one standard deviation per parameter: Ceres's covariance scaled by the residual
 // variance and by τ_int (the residuals are not independent).
@@ -521,7 +514,7 @@ struct Polished {
 };
 
 Polished polish(Work& w, const Theta& start, const FreeSet& free) {
-  quiet_ceres();
+  detail::quiet_ceres();
   Polished out;
   out.m = start;
   auto* cost = new TorqueCost(&w, free, start);

@@ -3,6 +3,7 @@
 // differences: each residual evaluation is one simulation) from the best points,
 // with the covariance of the final fit.
 #include "internal.hpp"
+#include "quiet_ceres.hpp"
 
 #include "backlash/numeric/effects.hpp"
 
@@ -79,6 +80,15 @@ double sum_of_squares(const std::vector<double>& r) {
 
 // ------------------------------------------------------------------ the fit
 
+// Ceres reports through glog: a failed evaluation is a status here, not a line on stderr.
+void quiet_ceres() {
+  static const bool once = [] {
+    FLAGS_minloglevel = google::GLOG_FATAL;
+    return true;
+  }();
+  (void)once;
+}
+
 namespace {
 
 struct Objective {
@@ -123,15 +133,6 @@ struct Solved {
   double sse = INFINITY;
   std::vector<double> covariance;  ///< of u (k × k), scaled by the residual variance
 };
-
-// Ceres reports through glog: a failed evaluation is a status here, not a line on stderr.
-void quiet_ceres() {
-  static const bool once = [] {
-    FLAGS_minloglevel = google::GLOG_FATAL;
-    return true;
-  }();
-  (void)once;
-}
 
 Solved solve(const Objective& objective, std::vector<double> u, bool with_covariance, int iterations) {
   quiet_ceres();

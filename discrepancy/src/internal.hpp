@@ -3,6 +3,7 @@
 
 #include "backlash/discrepancy/discrepancy.hpp"
 #include "backlash/numeric/effects_simulation.hpp"
+#include "backlash/output/text.hpp"
 
 #include <atomic>
 #include <cmath>
@@ -102,9 +103,10 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
                   double departure = NAN);
 
 /// Case-file text (case_file.cpp): the shortest decimal that reads back as the same double,
-/// a TOML basic string, and the original exact value when the fit kept it (else the decimal).
+/// a TOML basic string (backlash/output/text.hpp), and the original exact value when the fit
+/// kept it (else the decimal).
 std::string decimal(double value);
-std::string quoted(const std::string& text);
+using output::toml_string;
 std::string exact_or(const model::Rational& original, double value);
 
 }  // namespace backlash::discrepancy::detail

@@ -1,8 +1,11 @@
-// Guarded file access for backlash_measurements (POSIX: open/fstat, mkstemp,
-// fsync, rename).  Every failure is a one-line MeasuredDataError naming the file.
+// Guarded file access for backlash_measurements (POSIX: open/fstat; the writing through the
+// output layer, backlash/output/atomic_file.hpp).  Every failure is a one-line
+// MeasuredDataError naming the file.
 #include "file_access.hpp"
 
 #include "backlash/measurements/measured_record.hpp"
+#include "backlash/output/atomic_file.hpp"
+#include "backlash/output/output_error.hpp"
 
 #include <fmt/format.h>
 
@@ -57,12 +60,6 @@ class Descriptor {
     if (fd_ >= 0) ::close(fd_);
   }
   int get() const { return fd_; }
-  /// Closes now and reports close()'s own error (0 when fine).
-  int close_now() {
-    const int result = ::close(fd_);
-    fd_ = -1;
-    return result == 0 ? 0 : errno;
-  }
 
  private:
   int fd_;
@@ -117,52 +114,36 @@ std::string read_regular_file(const std::filesystem::path& file, std::uintmax_t 
   return content;
 }
 
+namespace {
+
+/// The output layer's refusal or failure in this library's words ("cannot write: …").
+std::string write_problem(const output::OutputError& error) {
+  const std::string& detail = error.detail();
+  switch (error.problem()) {
+    case output::Problem::empty_name: return "cannot write: empty file name";
+    case output::Problem::not_a_name: return "cannot write: not a file name";
+    case output::Problem::is_directory:
+    case output::Problem::is_symlink:
+    case output::Problem::not_regular: return "refusing to replace it: not a regular file (" + detail + ")";
+    case output::Problem::folder_missing: return "cannot write: directory " + detail + " does not exist";
+    case output::Problem::folder_not_directory: return "cannot write: " + detail + " is not a directory";
+    case output::Problem::create_failed: return "cannot write: cannot create a temporary file: " + detail;
+    case output::Problem::inspect_failed:
+    case output::Problem::folder_unreadable:
+    case output::Problem::write_failed:
+    case output::Problem::move_failed: return "cannot write: " + detail;
+    default: return std::string("cannot write: ") + error.what();
+  }
+}
+
+}  // namespace
+
 void write_file_atomically(const std::filesystem::path& target, std::string_view content) {
-  if (target.empty()) fail(target, "cannot write: empty file name");
-  if (!target.has_filename() || target.filename() == "." || target.filename() == "..")
-    fail(target, "cannot write: not a file name");
-
-  mode_t mode = 0644;
-  struct stat existing {};
-  if (::lstat(target.c_str(), &existing) == 0) {
-    if (!S_ISREG(existing.st_mode))
-      fail(target, fmt::format("refusing to replace it: not a regular file ({})", describe_file_type(existing.st_mode)));
-    mode = existing.st_mode & 07777;
-  } else if (errno != ENOENT) {
-    fail(target, "cannot write: " + errno_text(errno));
+  try {
+    output::write_atomically(target, content);
+  } catch (const output::OutputError& error) {
+    fail(target, write_problem(error));
   }
-
-  const std::filesystem::path directory = target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
-  struct stat directory_info {};
-  if (::stat(directory.c_str(), &directory_info) != 0) {
-    const int error_number = errno;
-    if (error_number == ENOENT) fail(target, "cannot write: directory " + directory.string() + " does not exist");
-    fail(target, "cannot write: " + errno_text(error_number));
-  }
-  if (!S_ISDIR(directory_info.st_mode)) fail(target, "cannot write: " + directory.string() + " is not a directory");
-
-  std::string temporary = (directory / fmt::format(".{}.tmp-XXXXXX", target.filename().string())).string();
-  Descriptor fd(::mkostemp(temporary.data(), O_CLOEXEC));
-  if (fd.get() < 0) fail(target, "cannot write: cannot create a temporary file: " + errno_text(errno));
-
-  auto give_up = [&](const std::string& problem) {
-    ::unlink(temporary.c_str());
-    fail(target, "cannot write: " + problem);
-  };
-
-  std::size_t written = 0;
-  while (written < content.size()) {
-    const ssize_t count = ::write(fd.get(), content.data() + written, content.size() - written);
-    if (count < 0) {
-      if (errno == EINTR) continue;
-      give_up(errno_text(errno));
-    }
-    written += static_cast<std::size_t>(count);
-  }
-  if (::fchmod(fd.get(), mode) != 0) give_up(errno_text(errno));
-  if (::fsync(fd.get()) != 0) give_up(errno_text(errno));
-  if (const int close_error = fd.close_now(); close_error != 0) give_up(errno_text(close_error));
-  if (::rename(temporary.c_str(), target.c_str()) != 0) give_up(errno_text(errno));
 }
 
 std::string printable(std::string_view text, std::size_t max_characters) {

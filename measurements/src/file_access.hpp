@@ -18,8 +18,9 @@ void require_readable_regular_file(const std::filesystem::path& file, std::uintm
 /// the opened descriptor before reading, and again while reading).
 std::string read_regular_file(const std::filesystem::path& file, std::uintmax_t max_bytes);
 
-/// Writes `content` to `target` through a unique temporary file in target's
-/// directory that is fsync'ed and renamed into place (see write_measured_csv).
+/// Writes `content` to `target` all at once (backlash/output/atomic_file.hpp: a unique
+/// temporary sibling, fsync'ed and renamed into place); its refusals and failures as
+/// MeasuredDataError(target, 0, "", "cannot write: …" or "refusing to replace it: …").
 void write_file_atomically(const std::filesystem::path& target, std::string_view content);
 
 /// Text made safe for a one-line message: control and non-ASCII bytes, quote

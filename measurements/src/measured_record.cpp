@@ -4,6 +4,8 @@
 
 #include "file_access.hpp"
 
+#include "backlash/output/text.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -116,21 +118,17 @@ std::string count_of_cells(std::size_t count) { return fmt::format("{} cell{}", 
 
 enum class NumberStatus { ok, empty, not_a_number, out_of_range, not_finite };
 
-/// A whole (trimmed) cell as a double, correctly rounded by std::from_chars.
+/// A whole (trimmed) cell as a double, correctly rounded (backlash/output/text.hpp).
 NumberStatus parse_number(std::string_view cell, double& value) {
-  if (cell.empty()) return NumberStatus::empty;
-  std::string_view digits = cell;
-  if (digits.front() == '+') {
-    digits.remove_prefix(1);
-    if (digits.empty() || digits.front() == '+' || digits.front() == '-') return NumberStatus::not_a_number;
+  switch (output::read_number(cell, value)) {
+    case output::NumberText::ok: return NumberStatus::ok;
+    case output::NumberText::empty: return NumberStatus::empty;
+    case output::NumberText::not_a_number: return NumberStatus::not_a_number;
+    case output::NumberText::too_large:
+    case output::NumberText::too_small: return NumberStatus::out_of_range;
+    case output::NumberText::not_finite: return NumberStatus::not_finite;
   }
-  const char* const end = digits.data() + digits.size();
-  const std::from_chars_result result = std::from_chars(digits.data(), end, value, std::chars_format::general);
-  if (result.ptr != end) return NumberStatus::not_a_number;
-  if (result.ec == std::errc::result_out_of_range) return NumberStatus::out_of_range;
-  if (result.ec != std::errc()) return NumberStatus::not_a_number;
-  if (!std::isfinite(value)) return NumberStatus::not_finite;
-  return NumberStatus::ok;
+  return NumberStatus::not_a_number;
 }
 
 bool looks_numeric(std::string_view cell) {

@@ -1,5 +1,6 @@
 #include "backlash/reports/plot.hpp"
 
+#include "backlash/output/text.hpp"
 #include "backlash/symbolic/escape.hpp"
 
 #include <cmath>
@@ -31,12 +32,6 @@ std::string number(double v) {
   char buffer[40];
   std::snprintf(buffer, sizeof buffer, "%.10g", v);
   return buffer;
-}
-
-std::string shell_quoted(const std::string& text) {
-  std::string out = "'";
-  for (char c : text) out += (c == '\'' ? std::string("'\\''") : std::string(1, c));
-  return out + "'";
 }
 
 // cairo stamps its PDFs with the time of day: overwrite the digits in place (same length,
@@ -198,7 +193,7 @@ std::optional<std::string> render_figures(const std::vector<Plot>& plots, const 
   }
   fs::create_directories(directory / "figures");
   const fs::path log = directory / "figures.log";
-  const std::string command = "cd " + shell_quoted(directory.string()) + " && gnuplot figures.gp > figures.log 2>&1";
+  const std::string command = "cd " + output::shell_word(directory.string()) + " && gnuplot figures.gp > figures.log 2>&1";
   const int status = std::system(command.c_str());
   std::optional<std::string> failure;
   if (status != 0) {

@@ -2,7 +2,9 @@
 // index, the figures, the machine-readable outputs and report.pdf.
 #include "backlash/reports/report.hpp"
 
-#include "backlash/reports/output_directory.hpp"
+#include "backlash/output/staged_directory.hpp"
+#include "backlash/output/target.hpp"
+#include "backlash/output/text.hpp"
 #include "backlash/symbolic/derivation_output.hpp"
 #include "backlash/symbolic/escape.hpp"
 #include "backlash/symbolic/general_derivation.hpp"
@@ -405,12 +407,6 @@ BuiltReport build_report(const DataPaths& paths) {
 
 namespace {
 
-std::string shell_quoted(const std::string& text) {
-  std::string out = "'";
-  for (char c : text) out += (c == '\'' ? std::string("'\\''") : std::string(1, c));
-  return out + "'";
-}
-
 std::string read_text(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
   std::ostringstream s;
@@ -420,7 +416,7 @@ std::string read_text(const fs::path& file) {
 
 // One pdflatex pass in `dir`; the log's text.
 bool run_pdflatex(const fs::path& dir, std::string& log) {
-  const std::string command = "cd " + shell_quoted(dir.string()) +
+  const std::string command = "cd " + output::shell_word(dir.string()) +
                               " && SOURCE_DATE_EPOCH=0 FORCE_SOURCE_DATE=1 pdflatex -interaction=nonstopmode -halt-on-error "
                               "report.tex > /dev/null 2>&1";
   const int status = std::system(command.c_str());
@@ -431,9 +427,9 @@ bool run_pdflatex(const fs::path& dir, std::string& log) {
 }  // namespace
 
 ReportResult write_report(const ReportOptions& options) {
-  check_output_target(options.out);
+  output::check_target(options.out, output::Target::folder);
   BuiltReport report = build_report();
-  StagedDirectory stage(options.out);
+  output::StagedDirectory stage(options.out);
   ReportResult result;
 
   // figures first (the pages refer to them)

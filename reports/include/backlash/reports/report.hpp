@@ -8,7 +8,7 @@
 // data files (thesis_data.hpp).
 //
 // The output is byte-reproducible (canonical printing, no dates, fixed PDF
-// metadata) and atomic (output_directory.hpp).
+// metadata) and atomic (backlash/output/staged_directory.hpp).
 #pragma once
 
 #include "backlash/reports/plot.hpp"
@@ -47,7 +47,7 @@ struct BuiltReport {
 
 BuiltReport build_report(const DataPaths& paths = default_data_paths());
 
-/// Build, draw, compile and move into place.  BadInput for an unusable --out
+/// Build, draw, compile and move into place.  output::OutputError (bad_target) for an unusable --out
 /// (checked before anything is computed); any other failure leaves nothing behind.
 ReportResult write_report(const ReportOptions& options);
 
