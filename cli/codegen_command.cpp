@@ -1,10 +1,10 @@
 // `backlash codegen CASE --out DIR` — writes the self-contained evaluator
 // header for a case (case_<ID>.hpp, depends only on <cmath>) and the LaTeX of
 // its expressions (case_<ID>.tex) into DIR.  CASE = I…VIII or a case file.
+// The files come from the GiNaC facade (api/derive.hpp: api::generate_code).
 #include "commands.hpp"
 
-#include "backlash/api/backlash.hpp"
-#include "backlash/codegen/emit.hpp"
+#include "backlash/api/derive.hpp"
 #include "backlash/output/atomic_file.hpp"
 #include "backlash/output/target.hpp"
 
@@ -27,9 +27,9 @@ void run_codegen(const CodegenOptions& options) {
   const api::Case source = api::load(options.case_name);  // the one route to a case
   output::OutputFiles files;
   std::vector<std::filesystem::path> names;
-  for (auto& file : codegen::emit_case_files(source.spec())) {
-    names.push_back(out / file.relative);
-    files.add(file.relative, std::move(file.content));
+  for (api::GeneratedFile& file : api::generate_code(source)) {
+    names.push_back(out / file.name);
+    files.add(file.name, std::move(file.content));
   }
   files.commit(out);
   for (const auto& name : names) std::cout << "wrote " << name.string() << "\n";

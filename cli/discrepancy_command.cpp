@@ -1,13 +1,14 @@
 // `backlash discrepancy --model M.toml --data D.csv [--step A] [--json] [--out DIR]` —
 // where the model and the measurement disagree, the missing effect named and
 // fitted, the gap before and after (docs/discrepancy.md), through the facade
-// (api::discrepancy).  A measured-drive model ([experiment] kind = "drive") runs the
+// (api::discrepancy; its JSON and files: api/discrepancy_pages.hpp).  A measured-drive model ([experiment] kind = "drive") runs the
 // torque-domain workflow, with [--validate D2.csv] [--cutoff HZ] [--window S]; a .mat
 // record (EMPS) is read as `backlash import` would convert it.
 #include "commands.hpp"
 #include "flags.hpp"
 
 #include "backlash/api/backlash.hpp"
+#include "backlash/api/discrepancy_pages.hpp"
 #include "backlash/output/staged_directory.hpp"
 #include "backlash/output/target.hpp"
 
@@ -47,10 +48,10 @@ void run_discrepancy(const DiscrepancyOptions& o) {
   const std::string validation_name = o.validate ? file_name(*o.validate) : "";
   if (!o.out.empty()) {
     output::StagedDirectory staged(o.out);
-    for (const auto& [name, content] : found.files(file_name(o.data), validation_name)) staged.write(name, content);
+    for (const auto& [name, content] : api::discrepancy_files(found, file_name(o.data), validation_name)) staged.write(name, content);
     staged.commit();
   }
-  if (o.json) return print(found.json());
+  if (o.json) return print(api::discrepancy_json(found));
   print(found.text(o.data, validation_name));
   if (!o.out.empty()) print("  written to " + o.out + "/discrepancy.md\n");
 }

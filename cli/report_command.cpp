@@ -2,12 +2,13 @@
 // derived, validated, traced, simulated, compared with the thesis and written
 // as a report (reports/report.hpp): case pages (Markdown + LaTeX), the general
 // solutions, the errata ledger, every thesis figure redrawn, report.pdf.
-// This file only parses the flags; the report is assembled in reports/.
+// This file only parses the flags; the report comes through the facade
+// (api/report.hpp: api::write_report), which lays it out with reports/.
 // Bad --out: one-line error, exit 2, nothing written.  The output folder
 // appears all at once (or not at all).
 #include "commands.hpp"
 
-#include "backlash/reports/report.hpp"
+#include "backlash/api/report.hpp"
 
 #include <chrono>
 #include <cstdio>
@@ -25,10 +26,10 @@ struct ReportCommandOptions {
 
 void run_report(const ReportCommandOptions& options) {
   const auto started = std::chrono::steady_clock::now();
-  reports::ReportOptions report_options;
-  report_options.out = options.out;
-  report_options.pdf = !options.no_pdf;
-  const reports::ReportResult result = reports::write_report(report_options);  // a bad --out: OutputError, exit 2 (main.cpp)
+  api::ReportRequest request;
+  request.out = options.out;
+  request.pdf = !options.no_pdf;
+  const api::Report result = api::write_report(request);  // a bad --out: OutputError, exit 2 (main.cpp)
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   char timing[32];
   std::snprintf(timing, sizeof timing, "%.2f", seconds);

@@ -1,6 +1,7 @@
 // derive.cpp — the exact derivation through the facade (GiNaC: backlash::api_derive only).
 #include "backlash/api/derive.hpp"
 
+#include "backlash/codegen/emit.hpp"
 #include "backlash/symbolic/derivation_output.hpp"
 #include "backlash/symbolic/forced_modes.hpp"
 #include "backlash/symbolic/general_derivation.hpp"
@@ -41,6 +42,22 @@ GeneralDerivation derive_general() {
     out.latex += symbolic::to_latex(branch) + "\n";
   }
   out.json = all.dump(2) + "\n";
+  return out;
+}
+
+std::vector<GeneratedFile> generate_code(const Case& source) {
+  const std::lock_guard<std::mutex> guard(ginac_lock());
+  std::vector<GeneratedFile> out;
+  for (codegen::GeneratedFile& file : codegen::emit_case_files(source.spec()))
+    out.push_back({file.relative.string(), std::move(file.content)});
+  return out;
+}
+
+ExactCase derive_exact(const Case& source) {
+  const std::lock_guard<std::mutex> guard(ginac_lock());
+  ExactCase out;
+  out.derivation = symbolic::derive_case(source.spec());
+  out.header = codegen::emit_case_header(source.spec(), out.derivation);
   return out;
 }
 

@@ -113,21 +113,6 @@ Discrepancy discrepancy(const Case& model, const measurements::MeasuredRecord& d
   return out;
 }
 
-std::string Discrepancy::json() const {
-  return step_ ? discrepancy::to_json(model_, *step_, step_value_) : discrepancy::drive_to_json(model_, *drive_);
-}
-
-std::vector<std::pair<std::string, std::string>> Discrepancy::files(const std::string& data_name,
-                                                                    const std::string& validation_name) const {
-  return step_ ? discrepancy::report_files(model_, data_name, *step_, step_value_)
-               : discrepancy::drive_report_files(model_, data_name, validation_name, *drive_);
-}
-
-std::string Discrepancy::corrected_case_file() const {
-  return step_ ? discrepancy::corrected_case_file(model_, *step_, step_value_)
-               : discrepancy::drive_corrected_case_file(model_, *drive_);
-}
-
 std::string Discrepancy::text(const std::string& data, const std::string& validation) const {
   std::string out;
   if (drive_) {

@@ -157,6 +157,32 @@ Trace Model::trace(const std::vector<double>& v0) const {
   return out;
 }
 
+numeric::DividingLinePoint Model::trace_point(double v0) const {
+  if (!std::isfinite(v0)) throw BadInput("v0", "not finite, got " + detail::number_text(v0));
+  return numeric::dividing_line_point(evaluator(), v0);
+}
+
+Simulation Model::simulate_from(const FreeFlightStart& start, double t_end, double sample_interval) const {
+  if (start.face != -1 && start.face != +1) throw BadInput("face", "expected -1 or +1, got " + std::to_string(start.face));
+  if (!std::isfinite(start.theta_o)) throw BadInput("theta_o", "not finite, got " + detail::number_text(start.theta_o));
+  if (!std::isfinite(start.dtheta_o)) throw BadInput("dtheta_o", "not finite, got " + detail::number_text(start.dtheta_o));
+  if (!std::isfinite(t_end) || t_end <= 0) throw BadInput("t_end", "must be > 0, got " + detail::number_text(t_end));
+  if (!std::isfinite(sample_interval) || sample_interval < 0)
+    throw BadInput("sample_interval", "must be >= 0, got " + detail::number_text(sample_interval));
+  Simulation out;
+  out.case_id = id();
+  out.t_end = t_end;
+  out.parameters = evaluator().parameters();
+  out.effects = effect_model().effects();
+  numeric::HybridState state = numeric::state_on_face(out.parameters, start.face, start.theta_o, start.dtheta_o, false);
+  state.drive_regime = numeric::drive_regime(out.parameters, out.effects, start.theta_o);
+  numeric::SimulationOptions options;
+  options.t_end = t_end;
+  options.sample_interval = sample_interval;
+  out.result = numeric::simulate_effects(effect_model(), state, options);
+  return out;
+}
+
 Cycle Model::limit_cycle() const {
   const model::CaseSpec& spec = case_.spec();
   numeric::EffectLimitCycleOptions options;

@@ -7,6 +7,7 @@
 //   BadInput, CaseFileError, MeasuredDataError   (subclasses of ValueError)
 //   ValidationFailed                              (a subclass of RuntimeError)
 #include "backlash/api/backlash.hpp"
+#include "backlash/api/discrepancy_pages.hpp"
 #include "backlash/api/map.hpp"
 #include "backlash/model/data_dir.hpp"
 
@@ -471,10 +472,10 @@ void bind_records_and_discrepancy(py::module_& m) {
       .def_property_readonly("noise", [](const api::Discrepancy& d) {
         return d.step_result() ? d.step_result()->noise : d.drive_result()->noise;
       })
-      .def("json", &api::Discrepancy::json)
+      .def("json", [](const api::Discrepancy& d) { return api::discrepancy_json(d); })
       .def("text", &api::Discrepancy::text, py::arg("data"), py::arg("validation") = "")
-      .def("files", &api::Discrepancy::files, py::arg("data_name"), py::arg("validation_name") = "")
-      .def("corrected_case_file", &api::Discrepancy::corrected_case_file);
+      .def("files", &api::discrepancy_files, py::arg("data_name"), py::arg("validation_name") = "")
+      .def("corrected_case_file", [](const api::Discrepancy& d) { return api::corrected_case_file(d); });
   m.def(
       "discrepancy",
       [](const PyCase& c, const measurements::MeasuredRecord& data, std::optional<double> step, int threads,

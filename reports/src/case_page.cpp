@@ -198,7 +198,7 @@ void dividing_line_table(doc::Document& out, const CaseResult& c, const ThesisDa
     if (cell.case_id != c.spec.id || cell.table != table) continue;
     auto found = points.find(cell.v0);
     if (found == points.end())
-      found = points.emplace(cell.v0, numeric::dividing_line_point(c.evaluator(), printed_number(cell.v0))).first;
+      found = points.emplace(cell.v0, c.model->trace_point(printed_number(cell.v0))).first;
     const numeric::DividingLinePoint& q = found->second;
     const std::string quantity = cell.quantity + " at dtheta_m0=" + cell.v0;
     const Erratum* e = find_erratum(data.errata, table, c.spec.id, quantity);
@@ -254,9 +254,10 @@ void step_points_table(doc::Document& out, const CaseResult& c, const ThesisData
   for (const StepPoint& sp : data.step_points) {
     if (sp.case_id != c.spec.id || !run.is_step || std::fabs(printed_number(sp.step) - run.step) > 1e-12) continue;
     table_name = sp.table;
-    numeric::SimulationOptions o;
-    o.t_end = printed_number(sp.t);
-    const numeric::SimulationResult at = numeric::simulate_step(c.evaluator(), run.step, o);
+    api::SimulationRequest request;
+    request.step = run.step;
+    request.t_end = printed_number(sp.t);
+    const numeric::SimulationResult at = c.model->simulate(request).result;
     double value = at.theta_o_final;
     if (sp.quantity == "theta_m") value = at.final_state.theta_m;
     if (sp.quantity == "theta_L") value = at.final_state.theta_L - at.final_state.face * p.backlash / 2;
@@ -463,7 +464,7 @@ doc::Document describing_function_section(const CaseResult& c) {
 doc::Document validation_section(const CaseResult& c) {
   doc::Document out;
   out.push_back(doc::heading(2, doc::text("The generated evaluator and its validation")));
-  const numeric::ValidationReport& report = c.validation.report();
+  const numeric::ValidationReport& report = c.validation().report();
   out.push_back(doc::paragraph(doc::text("The header emitted for this case by codegen (exact closed forms, constants rounded "
                                          "once) is checked against Boost.Odeint (dopri5, tolerance " +
                                          sig(numeric::ValidationOptions{}.odeint_tolerance, 2) + ") over the whole segment horizon: free mode to " +

@@ -2,7 +2,7 @@
 // limit cycle, describing function) and its figures.
 #include "report_parts.hpp"
 
-#include "backlash/codegen/emit.hpp"
+#include "backlash/api/derive.hpp"
 #include "backlash/symbolic/pretty.hpp"
 
 #include <algorithm>
@@ -109,74 +109,79 @@ std::vector<const FigureSpec*> figures_of(const ThesisData& data, const std::str
 
 // ---------------------------------------------------------------- computing a case
 
+namespace {
+
+// The thesis's other inputs of a case (steps, or starts in free flight on the separation line).
+TrajectoryRun thesis_run(const api::Model& model, const Trajectory& t, double t_end, const std::string& id) {
+  TrajectoryRun run;
+  run.source = t.quote;
+  if (t.kind == "step") {
+    run.step = printed_number(t.step);
+    run.label = "step " + sig(run.step, 6);
+    api::SimulationRequest request;
+    request.step = run.step;
+    request.t_end = t_end;
+    request.sample_interval = 0.01;
+    run.result = model.simulate(request).result;
+  } else if (t.kind == "state") {
+    run.is_step = false;
+    run.theta_o0 = printed_number(t.theta_o);
+    run.dtheta_o0 = printed_number(t.dtheta_o);
+    run.label = "start (" + sig(run.theta_o0, 6) + ", " + sig(run.dtheta_o0, 6) + ")";
+    run.result = model.simulate_from({run.dtheta_o0 > 0 ? -1 : +1, run.theta_o0, run.dtheta_o0}, t_end, 0.01).result;
+  } else {
+    throw std::runtime_error("thesis_cases.toml: case " + id + ": unknown trajectory kind '" + t.kind + "'");
+  }
+  return run;
+}
+
+// One period of the limit cycle from its separation point, closed.
+std::vector<numeric::TrajectorySample> cycle_orbit(const api::Model& model, const numeric::LimitCycle& cycle) {
+  const numeric::Parameters& p = model.evaluator().parameters();
+  const double v = cycle.separation_velocity;
+  std::vector<numeric::TrajectorySample> orbit =
+      model.simulate_from({-1, p.theta_R + model.evaluator().cot_phi() * v, v}, cycle.period, cycle.period / 800).result.samples;
+  if (!orbit.empty()) orbit.push_back(orbit.front());  // close the orbit
+  return orbit;
+}
+
+}  // namespace
+
 CaseResult compute_case(const std::string& id, const ThesisData& data) {
   CaseResult c;
-  c.spec = model::load_case(id);
+  const api::Case source = api::load(id);
+  c.model = std::make_shared<const api::Model>(source);  // the validation gates (ValidationFailed)
+  const api::Model& model = *c.model;
+  c.spec = source.spec();
   c.thesis = &data.thesis_case(id);
-  c.derivation = symbolic::derive_case(c.spec);
-  c.validation = numeric::validate(numeric::case_evaluator(c.spec));
-  if (!c.validation.passed()) {
-    std::string failing;
-    for (const numeric::StateError& s : c.validation.report().states)
-      if (!s.passed) failing += (failing.empty() ? "" : ", ") + s.state;
-    throw std::runtime_error("case " + id + ": the evaluator failed validation against odeint (" + failing + ")");
-  }
-  const numeric::ValidatedEvaluator& ev = c.evaluator();
-  c.parameters = ev.parameters();
-  const numeric::Parameters& p = c.parameters;
+  api::ExactCase exact = api::derive_exact(source);
+  c.derivation = std::move(exact.derivation);
+  c.generated_header = std::move(exact.header);
+  c.parameters = model.evaluator().parameters();
 
   std::vector<double> grid, negative;
   for (int k = 0; k <= 120; ++k) grid.push_back(0.01 * std::pow(150.0, k / 120.0));
   for (double v : grid) negative.push_back(-v);
-  c.lines_positive = numeric::trace_dividing_lines(ev, grid);
-  c.lines_negative = numeric::trace_dividing_lines(ev, negative);
+  c.lines_positive = model.trace(grid).lines;
+  c.lines_negative = model.trace(negative).lines;
 
-  numeric::SimulationOptions options;
-  options.t_end = 60;
-  options.sample_interval = 0.01;
+  double t_end = 60;
   if (c.spec.experiment) {
-    if (c.spec.experiment->t_end) options.t_end = model::to_double(*c.spec.experiment->t_end);
+    if (c.spec.experiment->t_end) t_end = model::to_double(*c.spec.experiment->t_end);
     TrajectoryRun run;
     run.step = model::to_double(c.spec.experiment->step);
     run.label = "step " + sig(run.step, 6);
     run.source = "the case file's [experiment]";
-    run.result = numeric::simulate_step(ev, run.step, options);
+    api::SimulationRequest request;
+    request.sample_interval = 0.01;
+    run.result = model.simulate(request).result;
     c.runs.push_back(std::move(run));
   }
-  for (const Trajectory& t : c.thesis->trajectories) {
-    TrajectoryRun run;
-    run.source = t.quote;
-    if (t.kind == "step") {
-      run.step = printed_number(t.step);
-      run.label = "step " + sig(run.step, 6);
-      run.result = numeric::simulate_step(ev, run.step, options);
-    } else if (t.kind == "state") {
-      run.is_step = false;
-      run.theta_o0 = printed_number(t.theta_o);
-      run.dtheta_o0 = printed_number(t.dtheta_o);
-      run.label = "start (" + sig(run.theta_o0, 6) + ", " + sig(run.dtheta_o0, 6) + ")";
-      const numeric::HybridState start =
-          numeric::state_on_face(p, run.dtheta_o0 > 0 ? -1 : +1, run.theta_o0, run.dtheta_o0, false);
-      run.result = numeric::simulate(ev, start, options);
-    } else {
-      throw std::runtime_error("thesis_cases.toml: case " + id + ": unknown trajectory kind '" + t.kind + "'");
-    }
-    c.runs.push_back(std::move(run));
-  }
+  for (const Trajectory& t : c.thesis->trajectories) c.runs.push_back(thesis_run(model, t, t_end, id));
 
-  c.cycle = numeric::find_limit_cycle(ev);
-  if (c.cycle.status == numeric::CycleStatus::LimitCycle) {
-    const double v = c.cycle.separation_velocity;
-    const numeric::HybridState start = numeric::state_on_face(p, -1, p.theta_R + ev.cot_phi() * v, v, false);
-    numeric::SimulationOptions o;
-    o.t_end = c.cycle.period;
-    o.sample_interval = c.cycle.period / 800;
-    const numeric::SimulationResult r = numeric::simulate(ev, start, o);
-    c.cycle_orbit = r.samples;
-    if (!c.cycle_orbit.empty()) c.cycle_orbit.push_back(c.cycle_orbit.front());  // close the orbit
-  }
-  c.describing_function = describing_function_prediction(p);
-  c.generated_header = codegen::emit_case_header(c.spec, c.derivation);
+  c.cycle = model.limit_cycle().cycle;
+  if (c.cycle.status == numeric::CycleStatus::LimitCycle) c.cycle_orbit = cycle_orbit(model, c.cycle);
+  c.describing_function = describing_function_prediction(c.parameters);
   return c;
 }
 
@@ -461,7 +466,7 @@ Plot separation_plot(const CaseResult& c, const FigureSpec& spec) {
   plot.series.push_back(m);
   plot.series.push_back(l);
   plot.x_range = std::pair{0.0, t_end};
-  const numeric::DividingLinePoint at = numeric::dividing_line_point(c.evaluator(), v);
+  const numeric::DividingLinePoint at = c.model->trace_point(v);
   if (at.status == numeric::RecombinationStatus::Recombination && at.t <= t_end) {
     plot.series.push_back({"recombination (gap = b) at t = " + fixed(at.t, 4), {at.t, at.t}, {at.theta_m - p.theta_R, at.theta_L - p.theta_R},
                            "linespoints lw 1 dt 3 pt 7 ps 1.2 lc rgb '#d62728'"});
@@ -476,7 +481,7 @@ Plot separation_plot(const CaseResult& c, const FigureSpec& spec) {
       levels.x.insert(levels.x.end(), {0, t_end, nan_value});
       levels.y.insert(levels.y.end(), {level, level, nan_value});
       plot.labels.push_back({"θ̇_{m0} = " + sig(vd, 4), 0.02 * t_end, level + 0.0});
-      const numeric::DividingLinePoint q = numeric::dividing_line_point(c.evaluator(), vd);
+      const numeric::DividingLinePoint q = c.model->trace_point(vd);
       if (q.status == numeric::RecombinationStatus::Recombination && q.t <= t_end) {
         hits.x.push_back(q.t);
         hits.y.push_back(level);
@@ -600,9 +605,12 @@ std::vector<Plot> case_figures(const CaseResult& c, const ThesisData& data) {
 
 std::vector<SweepResult> compute_sweeps() {
   std::vector<SweepResult> out;
-  numeric::SweepOptions options;
-  out.push_back({"fig31", numeric::run_sweep(numeric::figure31_points(101), options)});
-  out.push_back({"fig32", numeric::run_sweep(numeric::figure32_points(79), options)});
+  for (const auto& [name, points] : {std::pair<const char*, long>{"fig31", 101}, {"fig32", 79}}) {
+    api::SweepRequest request;
+    request.target = name;
+    request.points = points;
+    out.push_back({name, api::sweep(request).rows});
+  }
   return out;
 }
 

@@ -204,8 +204,8 @@ struct LatexBook {
 };
 
 std::string validation_json(const CaseResult& c) {
-  nlohmann::json v{{"case", c.spec.id}, {"evaluator", c.validation.report().evaluator}, {"passed", c.validation.passed()}};
-  for (const numeric::StateError& s : c.validation.report().states)
+  nlohmann::json v{{"case", c.spec.id}, {"evaluator", c.validation().report().evaluator}, {"passed", c.validation().passed()}};
+  for (const numeric::StateError& s : c.validation().report().states)
     v["states"].push_back({{"state", s.state}, {"max_abs_error", s.max_abs_error}, {"at_t", s.at_t}, {"passed", s.passed}});
   return v.dump(2) + "\n";
 }

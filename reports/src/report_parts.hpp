@@ -1,6 +1,7 @@
 // reports/src/report_parts.hpp — the pieces of the report (internal).
 #pragma once
 
+#include "backlash/api/backlash.hpp"
 #include "backlash/model/case_spec.hpp"
 #include "backlash/numeric/dividing_lines.hpp"
 #include "backlash/numeric/hybrid_simulation.hpp"
@@ -14,6 +15,7 @@
 #include "backlash/symbolic/document.hpp"
 
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -41,11 +43,14 @@ struct TrajectoryRun {
   numeric::SimulationResult result;
 };
 
+/// One case's results, every number a facade result (api/report.hpp): `model` is the
+/// validated api::Model the page asks for more (a table's dividing-line point, a state at a
+/// printed time); the derivation and the header come from api::derive_exact.
 struct CaseResult {
   model::CaseSpec spec;
   const ThesisCase* thesis = nullptr;
+  std::shared_ptr<const api::Model> model;
   symbolic::CaseDerivation derivation;
-  numeric::ValidationResult validation;
   numeric::Parameters parameters;
   numeric::DividingLines lines_positive, lines_negative;  ///< loci of both faces
   std::vector<TrajectoryRun> runs;                       ///< [0]: the case file's step
@@ -53,7 +58,8 @@ struct CaseResult {
   std::vector<numeric::TrajectorySample> cycle_orbit;    ///< one period from the separation point
   DescribingFunctionPrediction describing_function;
   std::string generated_header;                          ///< codegen's header for the case
-  const numeric::ValidatedEvaluator& evaluator() const { return validation.evaluator(); }
+  const numeric::ValidationResult& validation() const { return model->validation(); }
+  const numeric::ValidatedEvaluator& evaluator() const { return model->evaluator(); }
 };
 
 CaseResult compute_case(const std::string& id, const ThesisData& data);

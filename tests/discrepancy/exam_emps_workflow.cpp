@@ -10,6 +10,7 @@
 // estimates, not one number).  Then the validation record, with its force pulses, which
 // nothing was fitted on, must confirm the corrected model.
 #include "backlash/discrepancy/measured_drive.hpp"
+#include "backlash/reports/discrepancy_pages.hpp"
 #include "backlash/measurements/emps.hpp"
 #include "backlash/model/case_spec.hpp"
 

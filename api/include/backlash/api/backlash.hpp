@@ -25,7 +25,9 @@
 //      against a measured record), validate() (the gates' reports).  Each result keeps the
 //      numeric library's own result (its fields are documented there) and writes itself:
 //      json() / csv() / text() return exactly what the CLI prints for the same request
-//      (docs/design.md: the JSON keys are a contract), final newline included.
+//      (docs/design.md: the JSON keys are a contract), final newline included.  A
+//      discrepancy's JSON, page, figures and corrected case file are laid out apart, in
+//      backlash/api/discrepancy_pages.hpp (target backlash::api_pages, also without GiNaC).
 // The exact derivation (GiNaC) is apart, in backlash/api/derive.hpp (target
 // backlash::api_derive), so that a program using this header alone never links GiNaC.
 //
@@ -50,6 +52,7 @@
 
 #include "backlash/discrepancy/discrepancy.hpp"
 #include "backlash/discrepancy/measured_drive.hpp"
+#include "backlash/measurements/emps.hpp"
 #include "backlash/measurements/measured_record.hpp"
 #include "backlash/model/case_spec.hpp"
 #include "backlash/numeric/dividing_lines.hpp"
@@ -193,6 +196,16 @@ struct SimulationRequest {
   double sample_interval = 0;     ///< > 0: record the trajectory every this many seconds (csv())
 };
 
+/// A start in free flight just after a separation (the thesis's "second inputs", a point of
+/// a limit cycle on the separation line): both shafts at θ̇o [rad/s], the measured one at
+/// θo [rad], the gap at the face just left — face −1: θL − θm = −b/2 (the motor was pushing
+/// forward), +1: +b/2.  Model::simulate_from runs the model from it.
+struct FreeFlightStart {
+  int face = -1;
+  double theta_o = 0;   ///< [rad]
+  double dtheta_o = 0;  ///< [rad/s]
+};
+
 /// `trace`: the dividing lines — for each θ̇m0 on the separation line θo = θR + cot φ·θ̇m0,
 /// the first recombination (or recontact): time [s], motor and load just before the
 /// impact, the recombined θo, θ̇o just after it (eq. 24).  The thesis's frame:
@@ -255,8 +268,19 @@ class Model {
   /// log-spaced sweep, numeric::default_dividing_line_grid).  BadInput "v0" for an empty
   /// or non-finite list.
   Trace trace(const std::vector<double>& v0 = numeric::default_dividing_line_grid()) const;
+  /// The run from a free-flight start (not a step: Simulation::step is 0) to `t_end` [s] > 0,
+  /// sampled every `sample_interval` [s] (0: events only).  BadInput "face" (not ±1),
+  /// "theta_o" / "dtheta_o" (not finite), "t_end", "sample_interval".
+  Simulation simulate_from(const FreeFlightStart& start, double t_end, double sample_interval = 0) const;
+  /// One point of the dividing lines at θ̇m0 = `v0` [rad/s], found by the direct search for
+  /// the first gap event (numeric::dividing_line_point; trace() samples a profile instead):
+  /// how the thesis's printed table entries are checked.
+  numeric::DividingLinePoint trace_point(double v0) const;
   /// The limit cycle, seeded with the case's step experiment when it has one.
   Cycle limit_cycle() const;
+  /// The nominal model's validation: its evaluator and the report against odeint (per state:
+  /// max |error|, where, pass/fail; numeric/validation.hpp).  It passed (else no Model).
+  const numeric::ValidationResult& validation() const { return validation_; }
 
  private:
   Case case_;
@@ -356,15 +380,9 @@ class Discrepancy {
   const model::CaseSpec& model() const { return model_; }
   double step() const { return step_value_; }  ///< the step compared (0 for a drive)
 
-  std::string json() const;  ///< `discrepancy --json`
   /// `discrepancy`'s summary; `data` and `validation` name the records as the user gave them.
+  /// Its JSON, page, figures and corrected case file: backlash/api/discrepancy_pages.hpp.
   std::string text(const std::string& data, const std::string& validation = "") const;
-  /// The files of `discrepancy --out DIR` by name (page, figures, JSON, corrected.toml);
-  /// `data_name`, `validation_name`: the records' file names as the page cites them.
-  std::vector<std::pair<std::string, std::string>> files(const std::string& data_name,
-                                                         const std::string& validation_name = "") const;
-  /// The corrected model as a case file.
-  std::string corrected_case_file() const;
 
  private:
   friend Discrepancy discrepancy(const Case&, const measurements::MeasuredRecord&, const DiscrepancyRequest&);
@@ -381,6 +399,26 @@ class Discrepancy {
 /// BadInput "data" for a record the model cannot be compared with.
 Discrepancy discrepancy(const Case& model, const measurements::MeasuredRecord& data,
                         const DiscrepancyRequest& request = {});
+
+/// `import FILE --out CSV`: a record of a real drive converted into the project's CSV
+/// (docs/design.md, "Measured data (CSV)") for the measured-drive workflow.  EMPS
+/// (measurements/emps.hpp): t → t [s], qm → theta_out [m], the drive force on the mechanism
+/// → drive [N] = gtau·vir, plus pulses_N only if the data show the pulses are not already in
+/// vir (in the published validation record they are).
+struct Import {
+  std::string input, out;           ///< the paths as given
+  measurements::EmpsRecord emps;    ///< the record as read (gains kp, kv, gtau)
+  measurements::EmpsPulses pulses{};  ///< where the excitation pulses are
+  measurements::MeasuredRecord record;  ///< what was written
+  /// What `import` prints: samples, duration, sample rate, gains, columns, the pulses, and
+  /// the [experiment] table for a measured-drive model file.
+  std::string text() const;
+};
+
+/// Reads the EMPS .mat `input` and writes its CSV to `out` atomically (an existing regular
+/// file is replaced); measurements::MeasuredDataError (nothing written) for a record it
+/// cannot read or convert.
+Import import_record(const std::filesystem::path& input, const std::filesystem::path& out);
 
 // ====================================================================== 5. the gates' reports
 

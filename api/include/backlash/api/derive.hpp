@@ -17,8 +17,10 @@
 #pragma once
 
 #include "backlash/api/backlash.hpp"
+#include "backlash/symbolic/case_derivation.hpp"
 
 #include <string>
+#include <vector>
 
 namespace backlash::api {
 
@@ -40,5 +42,26 @@ struct GeneralDerivation {
   std::string json;   ///< `derive general --json`: an array, one entry per branch
 };
 GeneralDerivation derive_general();
+
+/// A file `codegen` writes: its name inside the output folder and its content.
+struct GeneratedFile {
+  std::string name;  ///< "case_V.hpp" (the evaluator), "case_V.tex" (its expressions)
+  std::string content;
+};
+
+/// `codegen CASE`: the self-contained evaluator header of the case (namespace case_<ID>,
+/// depends only on <cmath>: the closed forms of every segment with the case's numbers) and
+/// the LaTeX of its expressions, in the order the CLI writes them.  std::runtime_error (one
+/// line) if a verification of the derivation fails.
+std::vector<GeneratedFile> generate_code(const Case& source);
+
+/// The derivation as a structure, for a program that lays it out itself (the report's case
+/// pages: segments, steps, isoclines, eq. 38's C; symbolic/case_derivation.hpp), with the
+/// evaluator header `codegen` makes from it.
+struct ExactCase {
+  symbolic::CaseDerivation derivation;
+  std::string header;  ///< case_<ID>.hpp, byte for byte as generate_code's
+};
+ExactCase derive_exact(const Case& source);
 
 }  // namespace backlash::api

@@ -138,17 +138,7 @@ double estimate_noise(const std::vector<double>& y);
 /// The features of a trace.
 Features features_of(const std::vector<double>& t, const std::vector<double>& theta, double theta_R, double step);
 
-/// The files of `discrepancy --out DIR`, by name: discrepancy.md (the page), figures
-/// (measured_vs_models.svg, residual.svg, candidates.svg), discrepancy.json, corrected.toml.
-std::vector<std::pair<std::string, std::string>> report_files(const model::CaseSpec& model,
-                                                              const std::string& data_name,
-                                                              const DiscrepancyResult& result, double step);
-
-/// The JSON document of `discrepancy --json` (docs/design.md, "JSON keys", and more).
-std::string to_json(const model::CaseSpec& model, const DiscrepancyResult& result, double step);
-
-/// The corrected model as a case file: the nominal file's parameters, the backlash if it was
-/// refitted, and an [effects] table with the named effects (exact decimals of the fitted values).
-std::string corrected_case_file(const model::CaseSpec& model, const DiscrepancyResult& result, double step);
+// The result as files — the page, its figures, the JSON, the corrected case file — is
+// written apart from the computation: reports/discrepancy_pages.hpp.
 
 }  // namespace backlash::discrepancy

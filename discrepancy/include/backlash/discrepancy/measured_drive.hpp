@@ -139,18 +139,6 @@ DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& model, cons
                                               const DriveOptions& options = {},
                                               const measurements::MeasuredRecord* validation = nullptr);
 
-/// The files of `discrepancy --out DIR` for a measured drive: discrepancy.md, discrepancy.json,
-/// corrected.toml, torque_residual_vs_velocity.svg, torque_over_time.svg, position_window.svg,
-/// candidates.svg (and validation_position_window.svg with a validation record).
-std::vector<std::pair<std::string, std::string>> drive_report_files(const model::CaseSpec& model,
-                                                                    const std::string& data_name,
-                                                                    const std::string& validation_name,
-                                                                    const DriveDiscrepancyResult& result);
-
-/// The JSON of `discrepancy --json` (docs/design.md, "JSON keys"; torque RMS in rms_before/rms_after).
-std::string drive_to_json(const model::CaseSpec& model, const DriveDiscrepancyResult& result);
-
-/// The corrected model as a case file: refitted nominal parameters, the named effects.
-std::string drive_corrected_case_file(const model::CaseSpec& model, const DriveDiscrepancyResult& result);
+// The result as files: reports/discrepancy_pages.hpp.
 
 }  // namespace backlash::discrepancy

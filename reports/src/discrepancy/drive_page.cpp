@@ -1,9 +1,9 @@
 // The measured-drive workflow's results as files: JSON, a Markdown page with its figures
 // (deterministic SVG), and the corrected case file.  No timings in the files: the same
 // record gives the same bytes.
-#include "backlash/discrepancy/measured_drive.hpp"
+#include "backlash/reports/discrepancy_pages.hpp"
 
-#include "internal.hpp"
+#include "case_file_text.hpp"
 #include "page_json.hpp"
 #include "plots.hpp"
 

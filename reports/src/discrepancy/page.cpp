@@ -1,7 +1,8 @@
 // The results of the discrepancy workflow as files: the JSON, a Markdown page and
 // its figures (SVG drawn here, deterministically: the same result gives the same
 // bytes), and the corrected case file.
-#include "internal.hpp"
+#include "backlash/reports/discrepancy_pages.hpp"
+
 #include "page_json.hpp"
 #include "plots.hpp"
 

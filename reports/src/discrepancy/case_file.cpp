@@ -1,5 +1,7 @@
 // The corrected model as a case file that loads and simulates as it is.
-#include "internal.hpp"
+#include "backlash/reports/discrepancy_pages.hpp"
+
+#include "case_file_text.hpp"
 
 #include <charconv>
 #include <cmath>

@@ -1,4 +1,4 @@
-// discrepancy/src/page_json.hpp (internal) — the JSON pieces both result pages write
+// reports/src/discrepancy/page_json.hpp (internal) — the JSON pieces both result pages write
 // (the step record's page.cpp and the measured drive's drive_page.cpp): numbers (NaN as
 // null), a fit's parameters and their uncertainties, each candidate of each round, the
 // effects named.  nlohmann::json sorts an object's keys, so the bytes depend only on

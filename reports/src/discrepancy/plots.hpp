@@ -1,4 +1,4 @@
-// discrepancy/src/plots.hpp (internal) — small deterministic SVG plots for the
+// reports/src/discrepancy/plots.hpp (internal) — small deterministic SVG plots for the
 // discrepancy pages: the same data give the same bytes (numbers printed with %.6g,
 // no time stamps, no random ids).
 #pragma once
