@@ -28,10 +28,10 @@
 
 namespace {
 
-using backlash::numeric::DriveEventKind;
-using backlash::numeric::MeasuredDriveRun;
-using backlash::numeric::RigidDrive;
-using backlash::numeric::simulate_measured_drive;
+using backlash::discrepancy::DriveEventKind;
+using backlash::discrepancy::MeasuredDriveRun;
+using backlash::discrepancy::RigidDrive;
+using backlash::discrepancy::simulate_measured_drive;
 
 constexpr double eps = std::numeric_limits<double>::epsilon();
 constexpr double infinity = std::numeric_limits<double>::infinity();
