@@ -70,7 +70,6 @@ const numeric::ValidatedEffectModel& validated(const numeric::Effects& e) {
 numeric::SimulationOptions options() {
   numeric::SimulationOptions o;
   o.t_end = t_end;
-  o.general_engine = true;
   return o;
 }
 
@@ -90,7 +89,7 @@ void time_EffectsClosedForm(benchmark::State& state) {
   const numeric::SimulationOptions o = options();
   std::size_t events = 0;
   for (auto _ : state) {
-    const numeric::SimulationResult r = numeric::simulate_effects_step(model, step, o);
+    const numeric::SimulationResult r = numeric::simulate_effects_step(model, step, o, {.general_engine = true});
     events = r.events.size();
     benchmark::DoNotOptimize(r);
   }

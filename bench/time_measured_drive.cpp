@@ -1,4 +1,4 @@
-// time_ benchmarks of the measured-drive simulator (measured_drive.hpp; not timed tests):
+// time_ benchmarks of the measured-drive simulator (discrepancy/measured_drive_simulation.hpp; not timed tests):
 //   time_MeasuredDrive/<τ in µs>   one run over an EMPS-sized record: 24 841 samples at 1 kHz
 //                                  (t = 0 … 24.84 s), a synthetic controller output of EMPS's
 //                                  range (±4.3 V, gain 35.15 N/V) and the published EMPS rigid
@@ -6,7 +6,7 @@
 //                                  offset −3.16 N).  τ = 0 gives one hold piece per sample,
 //                                  τ = 500 µs two (the shifted samples fall between outputs).
 // The counter "per_piece" is the CPU time per hold piece.
-#include "backlash/numeric/measured_drive.hpp"
+#include "backlash/discrepancy/measured_drive_simulation.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -43,7 +43,7 @@ const Record& record() {
 
 void time_MeasuredDrive(benchmark::State& state) {
   const Record& r = record();
-  numeric::RigidDrive m;
+  discrepancy::RigidDrive m;
   m.J = 95.1089;
   m.F = 203.5034;
   m.coulomb = 20.3935;
@@ -52,7 +52,7 @@ void time_MeasuredDrive(benchmark::State& state) {
   m.delay = 1e-6 * static_cast<double>(state.range(0));
   std::size_t events = 0;
   for (auto _ : state) {
-    const numeric::MeasuredDriveRun run = numeric::simulate_measured_drive(m, r.t, r.drive, 0, samples - 1, 0.0, 0.0);
+    const discrepancy::MeasuredDriveRun run = discrepancy::simulate_measured_drive(m, r.t, r.drive, 0, samples - 1, 0.0, 0.0);
     events = run.event_count;
     benchmark::DoNotOptimize(run.x.data());
   }

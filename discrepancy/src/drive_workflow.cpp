@@ -6,7 +6,7 @@
 #include "quiet_ceres.hpp"
 
 #include "backlash/measurements/inverse_dynamics_signals.hpp"
-#include "backlash/numeric/measured_drive.hpp"
+#include "backlash/discrepancy/measured_drive_simulation.hpp"
 
 #include <Eigen/Dense>
 #include <boost/math/tools/minima.hpp>
@@ -567,8 +567,8 @@ Polished polish(Work& w, const Theta& start, const FreeSet& free) {
 
 // ------------------------------------------------------------------ position over windows
 
-numeric::RigidDrive rigid_drive(const Theta& m, double gain) {
-  numeric::RigidDrive d;
+RigidDrive rigid_drive(const Theta& m, double gain) {
+  RigidDrive d;
   d.J = m[kJ];
   d.F = m[kF];
   d.coulomb = m[kTc];
@@ -590,14 +590,14 @@ WindowPrediction predict_windows(const Prepared& p, const Theta& m, double gain,
   WindowPrediction out;
   out.x.assign(p.size(), NAN);
   const std::size_t length = std::max<std::size_t>(2, static_cast<std::size_t>(std::lround(window * p.fs)));
-  const numeric::RigidDrive drive = rigid_drive(m, gain);
+  const RigidDrive drive = rigid_drive(m, gain);
   double sum = 0;
   std::size_t count = 0;
   for (std::size_t first = 0; first + 1 < p.size(); first += length) {
     const std::size_t last = std::min(first + length, p.size() - 1);
     const double v0 = std::fabs(p.v[first]) <= rest_speed ? 0.0 : p.v[first];
-    const numeric::MeasuredDriveRun run =
-        numeric::simulate_measured_drive(drive, p.t, p.drive_raw, first, last, p.qf[first], v0);
+    const MeasuredDriveRun run =
+        simulate_measured_drive(drive, p.t, p.drive_raw, first, last, p.qf[first], v0);
     for (std::size_t k = first; k <= last; ++k) {
       out.x[k] = run.x[k - first];
       if (k > first) {
@@ -1015,7 +1015,7 @@ DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const
   DriveDiscrepancyResult result;
   result.given = numeric::parameters_of(spec);
   const numeric::Effects file_effects = numeric::effects_of(spec);
-  (void)numeric::rigid_drive_of(result.given, file_effects, gain);  // refuses effects that need a gap
+  (void)rigid_drive_of(result.given, file_effects, gain);  // refuses effects that need a gap
   std::vector<std::pair<std::string, int>> free_names;
   const FreeSet nominal_free = nominal_free_of(spec, where, free_names);
 

@@ -42,12 +42,11 @@ std::optional<std::vector<std::vector<double>>> Simulator::traces(const ModelPoi
   samples = std::min(samples, data_.size());
   o.sample_times.assign(data_.t.begin(), data_.t.begin() + static_cast<std::ptrdiff_t>(samples));
   o.t_end = std::min(t_end_, o.sample_times.back()) + 1e-9;
-  o.general_engine = true;
   o.max_events = 20000;  // a fit's trial point that needs more (a stiff, barely damped mesh) is a failed point
   ++simulations_;
   numeric::SimulationResult r;
   try {
-    r = numeric::simulate_effects_step(*model, step_, o);
+    r = numeric::simulate_effects_step(*model, step_, o, {.general_engine = true});
   } catch (const std::exception& error) {  // a point the simulation cannot resolve: no trace there
     if (std::getenv("BACKLASH_DEBUG_FITS")) std::fprintf(stderr, "discrepancy: simulation failed (%s): %s\n", m.e.describe().c_str(), error.what());
     return std::nullopt;

@@ -21,7 +21,7 @@
 
 #include "backlash/generated/cases.hpp"
 #include "backlash/model/case_spec.hpp"
-#include "backlash/numeric/effect_modes.hpp"
+#include "effects/effect_modes.hpp"
 #include "backlash/numeric/reference.hpp"
 #include "backlash/symbolic/forced_modes.hpp"
 

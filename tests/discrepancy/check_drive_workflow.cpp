@@ -5,7 +5,7 @@
 // workflow's position check uses, nor by anything of discrepancy/.
 //
 // DriveGenerator: the generator itself — it agrees with the project's exact simulator
-// (numeric/measured_drive.hpp, an independent implementation) fed its own logged drive, it is
+// (discrepancy/measured_drive_simulation.hpp, an independent implementation) fed its own logged drive, it is
 // deterministic, its positions are encoder counts, its records have EMPS's scale, a saturated
 // record's logged drive exceeds the limit, a bad spec is refused.
 //
@@ -63,7 +63,7 @@
 
 #include "backlash/discrepancy/measured_drive.hpp"
 #include "backlash/model/case_spec.hpp"
-#include "backlash/numeric/measured_drive.hpp"
+#include "backlash/discrepancy/measured_drive_simulation.hpp"
 
 #include <gtest/gtest.h>
 
@@ -119,10 +119,10 @@ TEST(DriveGenerator, AgreesWithTheExactSimulator) {
     spec.gain = c.gain;
     spec.trajectory.duration = 6;
     const DriveRecord r = generated_data::generate_drive_record(spec);
-    numeric::RigidDrive model;
+    discrepancy::RigidDrive model;
     model.J = kMass, model.F = kViscous, model.coulomb = c.coulomb, model.offset = c.offset;
     model.saturation = c.saturation, model.delay = c.delay, model.gain = c.gain;
-    const numeric::MeasuredDriveRun exact = numeric::simulate_measured_drive(
+    const discrepancy::MeasuredDriveRun exact = discrepancy::simulate_measured_drive(
         model, r.record.t, *r.record.drive, 0, r.record.size() - 1, r.position.front(), r.velocity.front());
     double dx = 0, dv = 0;
     for (std::size_t k = 0; k < r.record.size(); ++k)

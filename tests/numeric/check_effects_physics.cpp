@@ -61,9 +61,11 @@ SimulationOptions sampled(double t_end, double dt) {
   SimulationOptions o;
   o.t_end = t_end;
   o.sample_interval = dt;
-  o.general_engine = true;
   return o;
 }
+
+// The effects engine even where every effect is neutral (never the nominal shortcut).
+const numeric::EffectsEngineOptions general{.general_engine = true};
 
 // ------------------------------------------------------------------ neutral limits
 
@@ -74,8 +76,7 @@ TEST(EffectsNeutral, GeneralEngineReproducesTheNominalSimulatorOnEveryCase) {
       SimulationOptions o;
       o.t_end = 40;
       const SimulationResult n = numeric::simulate_step(nominal(id), step, o);
-      o.general_engine = true;
-      const SimulationResult g = numeric::simulate_effects_step(model, step, o);
+      const SimulationResult g = numeric::simulate_effects_step(model, step, o, general);
       EXPECT_EQ(numeric::to_string(g.status), std::string(numeric::to_string(n.status))) << id << " step " << step;
       ASSERT_EQ(g.events.size(), n.events.size()) << id << " step " << step;
       double worst = 0;
@@ -96,14 +97,13 @@ TEST(EffectsNeutral, TinyEffectsApproachTheNominalModel) {
   SimulationOptions o;
   o.t_end = 20;
   const SimulationResult reference = numeric::simulate_step(n, step_of("V"), o);
-  o.general_engine = true;
   std::vector<Effects> tiny(4);
   tiny[0].coulomb_load = 1e-9;
   tiny[1].restitution = 1e-9;
   tiny[2].saturation = 1e9;
   tiny[3].torque_offset = 1e-9;
   for (const Effects& e : tiny) {
-    const SimulationResult r = numeric::simulate_effects_step(with_effects(n, e), step_of("V"), o);
+    const SimulationResult r = numeric::simulate_effects_step(with_effects(n, e), step_of("V"), o, general);
     std::size_t compared = 0;
     for (std::size_t i = 0, j = 0; i < reference.events.size() && j < r.events.size(); ++j) {
       if (r.events[j].kind != reference.events[i].kind) continue;  // e.g. a vanishing bounce series
@@ -143,7 +143,7 @@ TEST(EffectsCoulomb, AFreeLoadStopsInFiniteTimeAtTheClosedFormInstant) {
   const auto& model = with_effects(nominal(p), coulomb(0, TL));
   HybridState s = numeric::state_on_face(p, -1, p.theta_R, 0, false);
   s.dtheta_L = v0;
-  const SimulationResult r = numeric::simulate_effects(model, s, sampled(6, 0.01));
+  const SimulationResult r = numeric::simulate_effects(model, s, sampled(6, 0.01), general);
   // JL θ̈ + FL θ̇ = −TL from v0: stops at (JL/FL)·ln(1 + FL v0/TL).
   const double expected = p.JL / p.FL * std::log(1 + p.FL * v0 / TL);
   const auto stick = std::find_if(r.events.begin(), r.events.end(), [](const numeric::SimulationEvent& e) {
@@ -162,7 +162,7 @@ TEST(EffectsCoulomb, AStuckMotorStaysPutInsideTheBandAndBreaksAwayAtItsEdge) {
   const Effects e = coulomb(0.05, 0);
   const auto& model = with_effects(nominal("V"), e);
   const Parameters& p = model.parameters();
-  const SimulationResult r = numeric::simulate_effects_step(model, step_of("V"), sampled(60, 0.005));
+  const SimulationResult r = numeric::simulate_effects_step(model, step_of("V"), sampled(60, 0.005), general);
   int breakaways = 0, sticks = 0;
   double stuck_since = -1, stuck_theta = 0;
   for (const numeric::SimulationEvent& ev : r.events) {
@@ -200,7 +200,7 @@ TEST(EffectsCoulomb, LargeFrictionStopsTheServoInADeadBandAwayFromTheReference) 
     const Effects e = coulomb(0.08, 0.06);
     const auto& model = with_effects(nominal(id), e);
     const Parameters& p = model.parameters();
-    const SimulationResult r = numeric::simulate_effects_step(model, step_of(id), sampled(80, 0));
+    const SimulationResult r = numeric::simulate_effects_step(model, step_of(id), sampled(80, 0), general);
     ASSERT_EQ(r.status, numeric::SimulationStatus::Rest) << id << " returned " << numeric::to_string(r.status);
     const double error = r.theta_o_final - p.theta_R;
     EXPECT_NE(error, 0.0) << id;
@@ -244,7 +244,7 @@ TEST(EffectsEnergy, WithTheOutputAtTheMotorTheEnergyNeverGrows) {
     for (const Effects& e : each) {
       const auto& model = with_effects(nominal(id), e);
       const Parameters& p = model.parameters();
-      const SimulationResult r = numeric::simulate_effects_step(model, step_of(id), sampled(30, 0.002));
+      const SimulationResult r = numeric::simulate_effects_step(model, step_of(id), sampled(30, 0.002), general);
       ASSERT_GT(r.samples.size(), 100u);
       double previous = energy(p, e, r.samples.front()), worst = 0;
       const double scale = std::max(1.0, previous);
@@ -265,7 +265,7 @@ TEST(EffectsImpact, MomentumIsConservedAndNewtonsLawHoldsAtEveryImpact) {
     e.restitution = e_value;
     const auto& model = with_effects(nominal(id), e);
     const Parameters& p = model.parameters();
-    const SimulationResult r = numeric::simulate_effects_step(model, step_of(id), sampled(40, 0));
+    const SimulationResult r = numeric::simulate_effects_step(model, step_of(id), sampled(40, 0), general);
     int impacts = 0;
     for (const numeric::SimulationEvent& ev : r.events) {
       if ((ev.kind != EventKind::Recombination && ev.kind != EventKind::Recontact) || ev.accumulation) continue;
@@ -288,7 +288,7 @@ TEST(EffectsImpact, ABounceSeriesEndsInContactAtItsAccumulationTime) {
   Effects e;
   e.restitution = 0.4;
   const auto& model = with_effects(nominal("III"), e);
-  const SimulationResult r = numeric::simulate_effects_step(model, step_of("III"), sampled(60, 0));
+  const SimulationResult r = numeric::simulate_effects_step(model, step_of("III"), sampled(60, 0), general);
   EXPECT_NE(r.status, numeric::SimulationStatus::Chattering);
   EXPECT_NE(r.status, numeric::SimulationStatus::EventLimit);
   int series = 0;
@@ -315,7 +315,7 @@ TEST(EffectsSaturation, TheDriveReachesAndLeavesItsLimitExactlyAtThePositionsKTh
   e.saturation = 0.3;
   const auto& model = with_effects(nominal("V"), e);
   const Parameters& p = model.parameters();
-  const SimulationResult r = numeric::simulate_effects_step(model, step_of("V"), sampled(60, 0));
+  const SimulationResult r = numeric::simulate_effects_step(model, step_of("V"), sampled(60, 0), general);
   int switches = 0;
   for (const numeric::SimulationEvent& ev : r.events) {
     if (ev.kind != EventKind::Saturation && ev.kind != EventKind::Desaturation) continue;
@@ -336,7 +336,7 @@ TEST(EffectsCompliance, TheMeshPushesAndNeverPulls) {
   for (const char* id : {"V", "I", "VIII"}) {
     const auto& model = with_effects(nominal(id), e);
     const Parameters& p = model.parameters();
-    const SimulationResult r = numeric::simulate_effects_step(model, step_of(id), sampled(40, 0.001));
+    const SimulationResult r = numeric::simulate_effects_step(model, step_of(id), sampled(40, 0.001), general);
     int engaged = 0;
     for (const numeric::TrajectorySample& s : r.samples) {
       for (int face : {-1, 1}) {
@@ -364,8 +364,7 @@ TEST(EffectsCompliance, AStiffWellDampedMeshApproachesTheRigidInelasticGear) {
     e.mesh_stiffness = stiffness;
     const double reduced_inertia = n.parameters().Jm * n.parameters().JL / (n.parameters().Jm + n.parameters().JL);
     e.mesh_damping = 2 * 20 * std::sqrt(stiffness * reduced_inertia);  // damping ratio 20
-    o.general_engine = true;
-    const SimulationResult r = numeric::simulate_effects_step(with_effects(n, e), step_of("V"), o);
+    const SimulationResult r = numeric::simulate_effects_step(with_effects(n, e), step_of("V"), o, general);
     ASSERT_GE(r.events.size(), 2u);
     const double gap = std::max(std::fabs(r.events[0].t - rigid.events[0].t), std::fabs(r.events[1].t - rigid.events[1].t));
     std::printf("stiffness %.0e: first separation and recombination within %.3e s of the rigid gear\n", stiffness, gap);
@@ -395,7 +394,7 @@ TEST(EffectsDelay, ARigidDelayedLoopOscillatesAtTheRootOfItsCharacteristicEquati
     Effects e;
     e.delay = tau;
     const auto& model = with_effects(nominal(p), e);
-    const SimulationResult r = numeric::simulate_effects_step(model, 1.0, sampled(40, 0.002));
+    const SimulationResult r = numeric::simulate_effects_step(model, 1.0, sampled(40, 0.002), general);
     // Zero crossings of θo − θR (cubic Hermite on the samples) and the extremes between them.
     std::vector<double> crossings, peaks;
     for (std::size_t i = 1; i < r.samples.size(); ++i) {
@@ -422,12 +421,11 @@ TEST(EffectsDelay, AVanishingDelayApproachesTheUndelayedModel) {
   SimulationOptions o;
   o.t_end = 10;
   const SimulationResult reference = numeric::simulate_step(n, step_of("V"), o);
-  o.general_engine = true;
   double previous = INFINITY;
   for (double tau : {1e-2, 1e-3}) {
     Effects e;
     e.delay = tau;
-    const SimulationResult r = numeric::simulate_effects_step(with_effects(n, e), step_of("V"), o);
+    const SimulationResult r = numeric::simulate_effects_step(with_effects(n, e), step_of("V"), o, general);
     ASSERT_GE(r.events.size(), 3u);
     double gap = 0;
     for (int i = 0; i < 3; ++i) gap = std::max(gap, std::fabs(r.events[i].t - reference.events[i].t));
@@ -464,7 +462,7 @@ TEST(EffectsPairs, EveryPairRunsToAStatusOnCaseV) {
       both.delay = std::max(both.delay, other.delay);
       both.torque_offset = both.torque_offset + other.torque_offset;
       const auto& model = with_effects(nominal("V"), both);
-      const SimulationResult r = numeric::simulate_effects_step(model, step_of("V"), sampled(60, 0.05));
+      const SimulationResult r = numeric::simulate_effects_step(model, step_of("V"), sampled(60, 0.05), general);
       const std::string label = single[i].first + " + " + single[j].first;
       EXPECT_TRUE(r.status == numeric::SimulationStatus::Completed || r.status == numeric::SimulationStatus::Rest)
           << label << " returned " << numeric::to_string(r.status);
@@ -527,9 +525,8 @@ TEST(EffectsLimitCycle, EachCycleIsWhereTheStepResponseEndsUp) {
     SimulationOptions so;
     so.t_end = 400;
     so.track_extremes = true;
-    so.extremes_after = 400 - 3 * c.period;
-    so.general_engine = true;
-    const SimulationResult r = numeric::simulate_effects_step(model, step_of("V"), so);
+    const SimulationResult r =
+        numeric::simulate_effects_step(model, step_of("V"), so, {.general_engine = true, .extremes_after = 400 - 3 * c.period});
     EXPECT_NEAR(r.extremes.theta_o_max - r.extremes.theta_o_min, c.peak_to_peak, 1e-7) << e.describe();
     std::printf("case V, %s: peak-to-peak %.9f, period %.6f, multiplier %.6f (%s)\n", e.describe().c_str(), c.peak_to_peak,
                 c.period, c.multiplier, c.method.c_str());

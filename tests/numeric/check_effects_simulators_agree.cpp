@@ -117,8 +117,7 @@ double compare(const SimulationResult& closed, const SimulationResult& odeint, c
 double run_both(const Parameters& p, const Effects& e, double step, double t_end, const std::string& label) {
   SimulationOptions o;
   o.t_end = t_end;
-  o.general_engine = true;
-  const SimulationResult closed = numeric::simulate_effects_step(model_of(p, e), step, o);
+  const SimulationResult closed = numeric::simulate_effects_step(model_of(p, e), step, o, {.general_engine = true});
   numeric::OdeintSimulationOptions reference;
   reference.tolerance = 1e-13;  // the reference must be well inside the 1e-9 s compared: at 1e-12 a
                                 // long coast (8 s of free flight) drifts 1.7e-9 s, at 1e-14 8e-12 s

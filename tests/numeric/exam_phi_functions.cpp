@@ -1,7 +1,7 @@
 // exam_phi_functions — the stable building blocks of the parametric layer
 // against known values (long-double series and closed forms), and their
 // continuity across the switches between series and closed forms.
-#include "backlash/numeric/phi_functions.hpp"
+#include "evaluators/phi_functions.hpp"
 
 #include <algorithm>
 

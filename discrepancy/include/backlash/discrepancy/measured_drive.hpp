@@ -22,7 +22,7 @@
 // within the filter's length of a start, a stop or a reversal, are not compared.
 // The torque residual is also checked where it matters to a user, in position: the model,
 // restarted from the measured state at the start of every window (0.5 s by default), predicts
-// the position over the window (numeric/measured_drive.hpp, exact for the zero-order-hold
+// the position over the window (measured_drive_simulation.hpp, exact for the zero-order-hold
 // drive); the page shows the RMS of those predictions before and after.
 //
 // The workflow:
@@ -53,7 +53,7 @@
 #include "backlash/measurements/measured_record.hpp"
 #include "backlash/model/case_spec.hpp"
 #include "backlash/numeric/effects.hpp"
-#include "backlash/numeric/measured_drive.hpp"
+#include "backlash/discrepancy/measured_drive_simulation.hpp"
 
 #include <cmath>
 #include <optional>

@@ -3,7 +3,7 @@
 //
 // Every mode that stays linear with constant forcing (Coulomb friction with
 // sticking, restitution, saturation, compliance, torque offset) is a closed
-// form (effect_modes.hpp), and every event is the first exit of a witness
+// form (numeric/effects/effect_modes.hpp), and every event is the first exit of a witness
 // w = row·z + constant from its valid side (w ≥ 0), found by the certified
 // search of first_crossing.hpp:
 //   rigid contact    −σ·Tc (separation), s·ω (the pair's velocity zero), the drive's limits
@@ -25,9 +25,10 @@
 // simulator (hybrid_simulation.hpp) runs, on the validated nominal evaluator.
 #pragma once
 
-#include "backlash/numeric/effect_modes.hpp"
 #include "backlash/numeric/effects.hpp"
+#include "backlash/numeric/effects_engine_options.hpp"
 #include "backlash/numeric/hybrid_simulation.hpp"
+#include "backlash/numeric/mode.hpp"
 #include "backlash/numeric/validated_family.hpp"
 #include "backlash/numeric/validation.hpp"
 
@@ -135,22 +136,12 @@ class ValidatedModelFamily {
   long validated_ = 0;
 };
 
-/// The accumulation threshold of docs/effects.md: a bounce series whose remaining duration is
-/// below this fraction of the servo period is summed, not simulated.
-inline constexpr double accumulation_fraction = 1e-7;
-
-/// Simulates from `start`.  Without effects (and without options.general_engine) this is
+/// Simulates from `start`.  Without effects (and without engine.general_engine) this is
 /// simulate() on the nominal evaluator, bit for bit.
 SimulationResult simulate_effects(const ValidatedEffectModel& model, const HybridState& start,
-                                  const SimulationOptions& options);
+                                  const SimulationOptions& options, const EffectsEngineOptions& engine = {});
 /// effects_step_start(p, e, step) simulated.
 SimulationResult simulate_effects_step(const ValidatedEffectModel& model, double step,
-                                       const SimulationOptions& options);
-
-namespace detail {
-/// The delayed model (Boost.Odeint, method of steps): effects_delay.cpp.
-SimulationResult simulate_delayed(const Parameters& p, const Effects& e, const HybridState& start,
-                                  const SimulationOptions& options);
-}  // namespace detail
+                                       const SimulationOptions& options, const EffectsEngineOptions& engine = {});
 
 }  // namespace backlash::numeric

@@ -100,13 +100,7 @@ struct SimulationOptions {
   /// (zeno_window(p, options)), so that the rule means the same for K = 1 and K = 1e12.
   double zeno_window = 0;
   long stop_after_separations = 0;  ///< > 0: stop (status completed) right after this many separations
-  /// (effects engine) stop_at_face = ±1: stop right after the first event of kind stop_at_kind
-  /// whose face (the face left by a separation, hit by an impact) is stop_at_face, at t > 0.
-  int stop_at_face = 0;
-  EventKind stop_at_kind = EventKind::Recombination;
   bool track_extremes = false;      ///< record the exact extremes of θo, θm, θL (zeros of the velocities)
-  double extremes_after = 0;        ///< (effects engine) extremes only of segments starting at or after this time
-  bool general_engine = false;      ///< simulate_effects: run the effects engine even when every effect is neutral
 };
 
 /// Exact extremes over the simulated time: at event states and at the certified
@@ -143,6 +137,10 @@ std::string zeno_reason(const SimulationOptions& options, double window);
 /// The measured shaft of a state, and its velocity.
 double measured(const Parameters& p, const HybridState& s);
 double measured_velocity(const Parameters& p, const HybridState& s);
+
+/// Widens `x` to include the angles θo, θm, θL of the state `s`: the one update of the running
+/// extremes, for every simulator (bookkeeping only, no dynamics).
+void include_extremes(const Parameters& p, const HybridState& s, Extremes& x);
 
 /// Records the trajectory at k·`options.sample_interval` (for CSV output) or at
 /// `options.sample_times`, into the result or into options.sample_sink; shared by the

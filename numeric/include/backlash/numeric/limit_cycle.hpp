@@ -84,6 +84,10 @@ struct LimitCycleOptions {
 
 LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycleOptions& options = {});
 
+/// The cycle's angles (θo extremes, separation and recombination angles, section state)
+/// moved by `offset`: from error coordinates to absolute ones.
+void shift_angles(LimitCycle& cycle, double offset);
+
 /// The unit of the search range: b/0.3 · √(K/J) — 1 for the thesis's cases III–VIII.  Cycles scale
 /// with the backlash and with the contact frequency, never with θR.
 double limit_cycle_velocity_unit(const Parameters& p);

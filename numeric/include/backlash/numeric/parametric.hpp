@@ -2,7 +2,7 @@
 // runtime parameters: the pole-structure branches, the dispatcher that picks
 // one, and the stable evaluator that is accurate on and near every branch.
 //
-// Method (see phi_functions.hpp for the building blocks).  With a = Fm/Jm,
+// Method (see numeric/evaluators/phi_functions.hpp for the building blocks).  With a = Fm/Jm,
 // b = FL/JL, k = K/Jm, x = −a·t, y = −b·t and θ0 = θR + cot φ·θ̇m0 (the
 // separation point), the free-mode solutions are written as divided
 // differences of e^{st} over their poles instead of partial fractions:
@@ -31,7 +31,7 @@
 // direct generated formulas (direct_branches.hpp) do.
 #pragma once
 
-#include "backlash/model/case_spec.hpp"
+#include "backlash/numeric/parameters.hpp"
 
 #include <array>
 #include <optional>
@@ -40,14 +40,6 @@
 #include <vector>
 
 namespace backlash::numeric {
-
-/// A case's parameters as doubles.
-struct Parameters {
-  double Jm = 1, Fm = 0, JL = 1, FL = 0, K = 1, theta_R = 0;
-  double backlash = 0;  ///< total backlash b (recombination when the gap has changed by b)
-  model::MeasuredAt measured_at = model::MeasuredAt::Load;
-};
-Parameters parameters_of(const model::CaseSpec& spec);
 
 /// Free-mode state at time t after separation (thesis convention: gap = θL − θm, 0 at separation).
 struct FreeState {

@@ -29,7 +29,7 @@ FreeState reference_free_state(const Parameters& p, double dtheta_m0, double t, 
 ContactState reference_contact_state(const Parameters& p, double theta_o0, double dtheta_o0, double t,
                                      double tolerance = 1e-12);
 
-/// Any linear mode z' = A z + c (the effect modes of effect_modes.hpp) from z0, at `times`.
+/// Any linear mode z' = A z + c (the effect modes of numeric/effects/effect_modes.hpp) from z0, at `times`.
 std::vector<SmallVector> reference_linear_trajectory(const LinearSegment& segment, const SmallVector& z0,
                                                      const std::vector<double>& times, double tolerance = 1e-12);
 

@@ -105,8 +105,4 @@ SweepPoint figure31_point(long n, long index);  ///< index < 2n, in the order of
 std::vector<SweepPoint> figure32_points(int n);
 SweepPoint figure32_point(long n, long index);  ///< index < 3n, in the order of figure32_points
 
-/// The cycle's angles (θo extremes, separation and recombination angles, section state)
-/// moved by `offset`: from error coordinates to absolute ones.
-void shift_angles(LimitCycle& cycle, double offset);
-
 }  // namespace backlash::numeric

@@ -1,0 +1,495 @@
+#include "effects/effect_modes.hpp"
+
+#include "evaluators/phi_functions.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <sstream>
+#include <vector>
+
+namespace backlash::numeric {
+
+namespace {
+
+bool at_motor(const Parameters& p) { return p.measured_at == model::MeasuredAt::Motor; }
+
+// The drive torque in a regime for the measured shaft at θo (no delay in a closed-form mode).
+double drive_at(const Parameters& p, const Effects& e, double theta_o, int regime) {
+  return drive_torque_in_regime(p, e, theta_o, regime);
+}
+
+}  // namespace
+
+std::string Mode::describe() const {
+  std::ostringstream out;
+  auto slip = [](int s) { return s > 0 ? "+" : s < 0 ? "-" : "stuck"; };
+  switch (kind) {
+    case ModeKind::Contact: out << "contact face " << face << " pair " << slip(slip_motor); break;
+    case ModeKind::Free: out << "free (left face " << face << ") motor " << slip(slip_motor) << " load " << slip(slip_load); break;
+    case ModeKind::Mesh: out << "mesh face " << face << " motor " << slip(slip_motor) << " load " << slip(slip_load); break;
+  }
+  if (regime != 0) out << ", drive clipped " << (regime > 0 ? "+L" : "-L");
+  return out.str();
+}
+
+std::vector<Mode> reachable_modes(const Parameters& p, const Effects& e) {
+  (void)p;
+  std::vector<Mode> modes;
+  const std::vector<int> regimes = e.saturating() ? std::vector<int>{0, 1, -1} : std::vector<int>{0};
+  const std::vector<int> pair_slips = e.coulomb() ? std::vector<int>{1, -1, 0} : std::vector<int>{1, -1};
+  const std::vector<int> motor_slips = e.coulomb_motor > 0 ? std::vector<int>{1, -1, 0} : std::vector<int>{1, -1};
+  const std::vector<int> load_slips = e.coulomb_load > 0 ? std::vector<int>{1, -1, 0} : std::vector<int>{1, -1};
+  for (int face : {-1, 1})
+    for (int regime : regimes) {
+      if (!e.compliant())
+        for (int s : pair_slips) modes.push_back({ModeKind::Contact, face, regime, s, s});
+      for (int sm : motor_slips)
+        for (int sl : load_slips) {
+          modes.push_back({ModeKind::Free, face, regime, sm, sl});
+          if (e.compliant()) modes.push_back({ModeKind::Mesh, face, regime, sm, sl});
+        }
+    }
+  return modes;
+}
+
+double penetration(const Parameters& p, int face, const HybridState& s) {
+  return face * (s.theta_L - s.theta_m) - p.backlash / 2;
+}
+
+double mesh_force(const Parameters& p, const Effects& e, int face, const HybridState& s) {
+  return e.mesh_stiffness * penetration(p, face, s) + e.mesh_damping * face * (s.dtheta_L - s.dtheta_m);
+}
+
+double motor_static_torque(const Parameters& p, const Effects& e, const HybridState& s) {
+  double torque = drive_at(p, e, measured(p, s), s.drive_regime);
+  if (e.compliant() && s.in_contact) torque += s.face * mesh_force(p, e, s.face, s);
+  return torque;
+}
+
+double load_static_torque(const Parameters& p, const Effects& e, const HybridState& s) {
+  if (e.compliant() && s.in_contact) return -s.face * mesh_force(p, e, s.face, s);
+  return 0;
+}
+
+double contact_torque(const Parameters& p, const Effects& e, const Mode& m, const HybridState& s) {
+  const double J = p.Jm + p.JL, F = p.Fm + p.FL, omega = s.dtheta_m;
+  const int slip = m.slip_motor;
+  if (slip == 0) return 0;
+  const double acceleration =
+      (drive_at(p, e, measured(p, s), m.regime) - F * omega - (e.coulomb_motor + e.coulomb_load) * slip) / J;
+  return p.JL * acceleration + p.FL * omega + e.coulomb_load * slip;
+}
+
+// ------------------------------------------------------------------ the generic flow (mesh modes)
+
+// z̃(τ) = e^{Mτ} z̃0 for the augmented M = [[A, c], [0, 0]]: by the eigen-decomposition of M when
+// it is diagonalisable with a well-conditioned basis (the generic mesh mode: two complex pairs
+// and the augmentation's 0), else by Eigen's Padé exponential at each τ.
+struct ModeFlow::Generic {
+  using Matrix5 = Eigen::Matrix<double, 5, 5>;
+  using ComplexMatrix5 = Eigen::Matrix<std::complex<double>, 5, 5>;
+  using ComplexVector5 = Eigen::Matrix<std::complex<double>, 5, 1>;
+  int n = 4;
+  Matrix5 M = Matrix5::Zero();
+  Eigen::Matrix<double, 5, 1> z0 = Eigen::Matrix<double, 5, 1>::Zero();
+  bool diagonal = false;
+  ComplexVector5 lambda, q;
+  ComplexMatrix5 V;
+
+  // The eigen-decomposition of an augmented matrix, kept per thread for the last few matrices:
+  // a mesh mode is entered again and again with the same matrix (the gap constant snapped to
+  // the face makes the augmentation column repeat), and the decomposition is most of a mesh
+  // segment's cost.  Exact comparison of the matrix: a hit gives the same bits as a recomputation.
+  struct Decomposition {
+    Matrix5 M;
+    int m = 0;
+    bool diagonal = false;
+    ComplexVector5 lambda;
+    ComplexMatrix5 V, inverse;
+  };
+  static const Decomposition& decomposition(const Matrix5& M, int m) {
+    thread_local std::vector<Decomposition> cache;
+    thread_local std::size_t next = 0;
+    for (const Decomposition& d : cache)
+      if (d.m == m && d.M == M) return d;
+    Decomposition d;
+    d.M = M;
+    d.m = m;
+    d.lambda = ComplexVector5::Zero();
+    d.V = ComplexMatrix5::Zero();
+    d.inverse = ComplexMatrix5::Zero();
+    Eigen::EigenSolver<Eigen::MatrixXd> solver(M.topLeftCorner(m, m), true);
+    if (solver.info() == Eigen::Success) {
+      const Eigen::MatrixXcd vectors = solver.eigenvectors();
+      Eigen::PartialPivLU<Eigen::MatrixXcd> lu(vectors);
+      const Eigen::MatrixXcd inverse = lu.inverse();
+      const double condition =
+          vectors.cwiseAbs().rowwise().sum().maxCoeff() * inverse.cwiseAbs().rowwise().sum().maxCoeff();
+      if (std::isfinite(condition) && condition <= 1e7) {
+        d.V.topLeftCorner(m, m) = vectors;
+        d.inverse.topLeftCorner(m, m) = inverse;
+        d.lambda.head(m) = solver.eigenvalues();
+        d.diagonal = true;
+      }
+    }
+    constexpr std::size_t capacity = 16;
+    if (cache.size() < capacity) {
+      cache.push_back(std::move(d));
+      return cache.back();
+    }
+    cache[next] = std::move(d);
+    const std::size_t at = next;
+    next = (next + 1) % capacity;
+    return cache[at];
+  }
+
+  Generic(const LinearSegment& s, const SmallVector& start) : n(static_cast<int>(s.A.rows())) {
+    M.topLeftCorner(n, n) = s.A;
+    M.block(0, n, n, 1) = s.c;
+    z0.head(n) = start;
+    z0(n) = 1;
+    const int m = n + 1;
+    const Decomposition& d = decomposition(M, m);
+    if (!d.diagonal) return;
+    V = d.V;
+    lambda = d.lambda;
+    q = ComplexVector5::Zero();
+    q.head(m) = d.inverse.topLeftCorner(m, m) * z0.head(m).cast<std::complex<double>>();
+    diagonal = true;
+  }
+
+  SmallVector at(double tau) const {
+    const int m = n + 1;
+    if (diagonal) {
+      Eigen::Matrix<std::complex<double>, 5, 1> weights = Eigen::Matrix<std::complex<double>, 5, 1>::Zero();
+      for (int j = 0; j < m; ++j) weights(j) = std::exp(lambda(j) * tau) * q(j);
+      SmallVector z(n);
+      for (int i = 0; i < n; ++i) {
+        std::complex<double> sum = 0;
+        for (int j = 0; j < m; ++j) sum += V(i, j) * weights(j);
+        z(i) = sum.real();
+      }
+      return z;
+    }
+    const Eigen::MatrixXd E = (Eigen::MatrixXd(M.topLeftCorner(m, m)) * tau).exp();
+    return SmallVector((E * z0.head(m)).head(n));
+  }
+};
+
+// ------------------------------------------------------------------ ModeFlow
+
+namespace {
+
+// The contact mode's system: z = (d, ω) with d = θo − θR − y* under the linear drive, else
+// z = (Δ, ω) with the drive as a constant (saturated) or an external input.
+void contact_system(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start,
+                    bool drive_external, ModeSystem& sys) {
+  const double J = p.Jm + p.JL, F = p.Fm + p.FL;
+  const double T = e.coulomb_motor + e.coulomb_load;
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  const double offset = std::fabs(e.torque_offset);
+  const double theta_o0 = measured(p, start);
+  const bool linear_drive = m.regime == 0 && !drive_external;
+  LinearSegment& s = sys.segment;
+  const double omega0 = start.dtheta_m;
+  if (m.slip_motor == 0) return;  // stuck: nothing moves
+  sys.z0_noise(1) = 4 * eps * std::fabs(omega0);
+  s.A(0, 1) = 1;
+  s.A(1, 1) = -F / J;
+  if (linear_drive) {  // z = (d, ω), d = θo − θR − y*: J d'' + F d' + K d = 0
+    const double y_star = (e.torque_offset - T * m.slip_motor) / p.K;
+    s.A(1, 0) = -p.K / J;
+    sys.z0 << theta_o0 - p.theta_R - y_star, omega0;
+    sys.z0_noise(0) = 4 * eps * (std::fabs(theta_o0) + std::fabs(p.theta_R) + (offset + T) / p.K);
+  } else {  // z = (Δ, ω): J Δ'' + F Δ' = D − T s
+    const double drive = drive_external ? 0.0 : m.regime * e.saturation + e.torque_offset;
+    s.c(1) = (drive - T * m.slip_motor) / J;
+    sys.c_magnitude(1) = ((drive_external ? 0.0 : e.saturation + offset) + T) / J;
+    if (drive_external) sys.drive_column(1) = 1 / J;
+    sys.z0 << 0, omega0;
+  }
+}
+
+// The mesh engaged on face σ: the spring-damper force couples the motor and the load rows.
+void add_mesh_coupling(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start,
+                       ModeSystem& sys) {
+  LinearSegment& s = sys.segment;
+  // σP = kc (x0 + ΔL − Δm) − σ kc b/2 + cc (θ̇L − θ̇m) acts on the motor (+σP) and the load (−σP).
+  const double kc = e.mesh_stiffness, cc = e.mesh_damping, sigma = m.face;
+  const double x0 = start.theta_L - start.theta_m;
+  const double constant = kc * x0 - sigma * kc * p.backlash / 2;
+  const double constant_magnitude = kc * (std::fabs(start.theta_L) + std::fabs(start.theta_m) + p.backlash / 2);
+  if (m.slip_motor != 0) {
+    s.A(1, 0) += -kc / p.Jm;
+    s.A(1, 1) += -cc / p.Jm;
+    s.A(1, 2) += kc / p.Jm;
+    s.A(1, 3) += cc / p.Jm;
+    s.c(1) += constant / p.Jm;
+    sys.c_magnitude(1) += constant_magnitude / p.Jm;
+  }
+  if (m.slip_load != 0) {
+    s.A(3, 0) += kc / p.JL;
+    s.A(3, 1) += cc / p.JL;
+    s.A(3, 2) += -kc / p.JL;
+    s.A(3, 3) += -cc / p.JL;
+    s.c(3) += -constant / p.JL;
+    sys.c_magnitude(3) += constant_magnitude / p.JL;
+  }
+}
+
+}  // namespace
+
+ModeSystem mode_system(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start,
+                       bool drive_external) {
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  const double offset = std::fabs(e.torque_offset);
+  ModeSystem sys;
+  const int n = m.kind == ModeKind::Contact ? 2 : 4;
+  sys.segment = LinearSegment{SmallMatrix::Zero(n, n), SmallVector::Zero(n)};
+  sys.z0 = SmallVector::Zero(n);
+  sys.z0_noise = SmallVector::Zero(n);
+  sys.c_magnitude = SmallVector::Zero(n);
+  sys.drive_column = SmallVector::Zero(n);
+  LinearSegment& s = sys.segment;
+  const double theta_o0 = measured(p, start);
+  const bool linear_drive = m.regime == 0 && !drive_external;
+  if (m.kind == ModeKind::Contact) {
+    contact_system(p, e, m, start, drive_external, sys);
+    return sys;
+  }
+  // Free flight and mesh: z = (Δm, θ̇m, ΔL, θ̇L).
+  sys.z0 << 0, start.dtheta_m, 0, start.dtheta_L;
+  sys.z0_noise << 0, 4 * eps * std::fabs(start.dtheta_m), 0, 4 * eps * std::fabs(start.dtheta_L);
+  s.A(0, 1) = 1;
+  s.A(2, 3) = 1;
+  if (m.slip_motor != 0) {
+    double drive = 0, drive_magnitude = 0;
+    if (drive_external) {
+      sys.drive_column(1) = 1 / p.Jm;
+    } else {
+      drive = drive_at(p, e, theta_o0, m.regime);
+      drive_magnitude = (linear_drive ? p.K * (std::fabs(p.theta_R) + std::fabs(theta_o0)) : e.saturation) + offset;
+      if (linear_drive) (at_motor(p) ? s.A(1, 0) : s.A(1, 2)) = -p.K / p.Jm;
+    }
+    s.A(1, 1) = -p.Fm / p.Jm;
+    s.c(1) = (drive - e.coulomb_motor * m.slip_motor) / p.Jm;
+    sys.c_magnitude(1) = (drive_magnitude + e.coulomb_motor) / p.Jm;
+  }
+  if (m.slip_load != 0) {
+    s.A(3, 3) = -p.FL / p.JL;
+    s.c(3) = -e.coulomb_load * m.slip_load / p.JL;
+    sys.c_magnitude(3) = e.coulomb_load / p.JL;
+  }
+  if (m.kind == ModeKind::Mesh) add_mesh_coupling(p, e, m, start, sys);
+  return sys;
+}
+
+ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start)
+    : p_(p), e_(e), mode_(m), start_(start) {
+  const ModeSystem sys = mode_system(p, e, m, start, false);
+  segment_ = sys.segment;
+  z0_ = sys.z0;
+  z0_noise_ = sys.z0_noise;
+  c_magnitude_ = sys.c_magnitude;
+  const double J = p.Jm + p.JL, F = p.Fm + p.FL;
+  const double T = e.coulomb_motor + e.coulomb_load;
+  if (m.kind == ModeKind::Contact) {
+    if (m.slip_motor == 0) return;
+    if (m.regime == 0) {
+      y_star_ = (e.torque_offset - T * m.slip_motor) / p.K;
+      alpha_ = F / (2 * J);
+      w2_ = p.K / J;
+    } else {
+      beta_ = F / J;
+      g_ = segment_.c(1);
+    }
+    return;
+  }
+  if (m.kind == ModeKind::Mesh) {
+    generic_ = std::make_shared<const Generic>(segment_, z0_);
+    return;
+  }
+  // Free flight: closed forms.
+  a_ = p.Fm / p.Jm;
+  b_ = p.FL / p.JL;
+  k_ = p.K / p.Jm;
+  gL_ = segment_.c(3);
+  if (m.slip_motor == 0) {
+    motor_form_ = 0;
+  } else if (m.regime != 0 || (!at_motor(p) && m.slip_load == 0)) {
+    motor_form_ = 1;  // constant drive
+    gm_ = segment_.c(1);
+  } else if (at_motor(p)) {
+    motor_form_ = 2;  // its own closed loop
+    y_star_ = (e.torque_offset - e.coulomb_motor * m.slip_motor) / p.K;
+    alpha_m_ = p.Fm / (2 * p.Jm);
+    w2_m_ = p.K / p.Jm;
+  } else {
+    motor_form_ = 3;  // driven by the moving load
+    c0_ = segment_.c(1);
+  }
+}
+
+SmallVector ModeFlow::local(double tau) const {
+  const Mode& m = mode_;
+  if (generic_) return generic_->at(tau);
+  if (m.kind == ModeKind::Contact) {
+    SmallVector z(2);
+    if (m.slip_motor == 0) {
+      z << 0, 0;
+    } else if (m.regime == 0) {
+      const DampedPair dp = damped_pair(alpha_, w2_, tau);
+      const double d0 = z0_(0), w0 = z0_(1);
+      z << d0 * dp.c + (w0 + alpha_ * d0) * dp.s, w0 * dp.c - (alpha_ * w0 + w2_ * d0) * dp.s;
+    } else {
+      const double x = -beta_ * tau, w0 = z0_(1);
+      z << w0 * tau * phi(1, x) + g_ * tau * tau * phi(2, x), w0 * std::exp(x) + g_ * tau * phi(1, x);
+    }
+    return z;
+  }
+  SmallVector z(4);
+  const double vm0 = z0_(1), vL0 = z0_(3);
+  const double y = -b_ * tau, x = -a_ * tau, t2 = tau * tau;
+  const CoupledKernels k = coupled_kernels(x, y);
+  if (m.slip_load == 0) {
+    z(2) = 0;
+    z(3) = 0;
+  } else {
+    z(2) = vL0 * tau * k.phi1_y + gL_ * t2 * k.phi2_y;
+    z(3) = vL0 * k.exp_y + gL_ * tau * k.phi1_y;
+  }
+  switch (motor_form_) {
+    case 0:
+      z(0) = 0;
+      z(1) = 0;
+      break;
+    case 1:
+      z(0) = vm0 * tau * k.phi1_x + gm_ * t2 * k.phi2_x;
+      z(1) = vm0 * k.exp_x + gm_ * tau * k.phi1_x;
+      break;
+    case 2: {
+      const double y0 = measured(p_, start_) - p_.theta_R - y_star_;
+      const DampedPair dp = damped_pair(alpha_m_, w2_m_, tau);
+      z(0) = y0 * (dp.c - 1) + (vm0 + alpha_m_ * y0) * dp.s;
+      z(1) = vm0 * dp.c - (alpha_m_ * vm0 + w2_m_ * y0) * dp.s;
+      break;
+    }
+    default:
+      z(0) = vm0 * tau * k.phi1_x + c0_ * t2 * k.phi2_x - k_ * vL0 * t2 * tau * k.a2 - k_ * gL_ * t2 * t2 * k.a3;
+      z(1) = vm0 * k.exp_x + c0_ * tau * k.phi1_x - k_ * vL0 * t2 * k.a1 - k_ * gL_ * t2 * tau * k.a2;
+      break;
+  }
+  return z;
+}
+
+HybridState ModeFlow::state_of(const SmallVector& z) const {
+  HybridState h;
+  const Mode& m = mode_;
+  if (m.kind == ModeKind::Contact) {
+    const double theta_o = p_.theta_R + theta_o_error().constant + z(0);
+    h = state_on_face(p_, m.face, theta_o, z(1), true);
+    h.motor_stuck = h.load_stuck = m.slip_motor == 0;
+  } else {
+    h.theta_m = start_.theta_m + z(0);
+    h.dtheta_m = z(1);
+    h.theta_L = start_.theta_L + z(2);
+    h.dtheta_L = z(3);
+    h.in_contact = m.kind == ModeKind::Mesh;
+    h.face = m.face;
+    h.motor_stuck = m.slip_motor == 0;
+    h.load_stuck = m.slip_load == 0;
+  }
+  h.drive_regime = m.regime;
+  return h;
+}
+
+bool ModeFlow::uses_matrix_exponential() const { return generic_ && !generic_->diagonal; }
+
+std::function<double(double, double)> ModeFlow::derivative_bound(const SmallRow& row, int order) const {
+  if (!generic_ || !generic_->diagonal) return {};
+  const Generic& g = *generic_;
+  const int m = g.n + 1;
+  std::vector<std::pair<double, double>> terms;  // (|c_j||λ_j|^order, Re λ_j)
+  for (int j = 0; j < m; ++j) {
+    std::complex<double> c = 0;
+    for (int i = 0; i < g.n; ++i) c += row(i) * g.V(i, j);
+    const double size = std::abs(c * g.q(j)) * std::pow(std::abs(g.lambda(j)), order);
+    if (size > 0) terms.push_back({size, g.lambda(j).real()});
+  }
+  return [terms](double a, double b) {
+    double bound = 0;
+    for (const auto& [size, rate] : terms) bound += size * std::exp(rate * (rate > 0 ? b : a));
+    return bound * (1 + 1e-9) + 1e-300;
+  };
+}
+
+HybridState ModeFlow::state(double tau) const { return state_of(local(tau)); }
+
+ModeFlow::Functional ModeFlow::theta_o_error() const {
+  Functional f;
+  if (mode_.kind == ModeKind::Contact) {
+    f.row = SmallRow::Zero(2);
+    f.row(0) = 1;
+    f.constant = mode_.slip_motor != 0 && mode_.regime == 0 ? y_star_ : measured(p_, start_) - p_.theta_R;
+    f.magnitude = std::fabs(measured(p_, start_)) + std::fabs(p_.theta_R) + std::fabs(y_star_);
+    return f;
+  }
+  f.row = SmallRow::Zero(4);
+  f.row(at_motor(p_) ? 0 : 2) = 1;
+  f.constant = measured(p_, start_) - p_.theta_R;
+  f.magnitude = std::fabs(measured(p_, start_)) + std::fabs(p_.theta_R);
+  return f;
+}
+
+ModeFlow::Functional ModeFlow::gap_functional() const {
+  Functional f;
+  if (mode_.kind == ModeKind::Contact) {
+    f.row = SmallRow::Zero(2);
+    f.constant = mode_.face * p_.backlash / 2;
+    f.magnitude = p_.backlash / 2;
+    return f;
+  }
+  f.row = SmallRow::Zero(4);
+  f.row(0) = -1;
+  f.row(2) = 1;
+  f.constant = start_.theta_L - start_.theta_m;
+  f.magnitude = std::fabs(start_.theta_L) + std::fabs(start_.theta_m);
+  // A flight that starts on a face (after a separation or an impact, placed there exactly)
+  // starts exactly at ±b/2: its gap is not the rounding of θL − θm, which would put a
+  // millionth of a tiny bounce's height into the constant.
+  for (int face : {-1, 1})
+    if (std::fabs(f.constant - face * p_.backlash / 2) <= 8 * std::numeric_limits<double>::epsilon() * f.magnitude)
+      f.constant = face * p_.backlash / 2;
+  return f;
+}
+
+ModeFlow::Functional ModeFlow::motor_velocity() const {
+  Functional f;
+  f.row = SmallRow::Zero(segment_.A.rows());
+  f.row(1) = 1;
+  return f;
+}
+
+ModeFlow::Functional ModeFlow::load_velocity() const {
+  Functional f;
+  f.row = SmallRow::Zero(segment_.A.rows());
+  f.row(mode_.kind == ModeKind::Contact ? 1 : 3) = 1;
+  return f;
+}
+
+double ModeFlow::gap(const SmallVector& z) const {
+  const Functional f = gap_functional();
+  return f.row.dot(z) + f.constant;
+}
+
+double ModeFlow::theta_o(const SmallVector& z) const {
+  const Functional f = theta_o_error();
+  return p_.theta_R + f.row.dot(z) + f.constant;
+}
+
+}  // namespace backlash::numeric

@@ -1,0 +1,543 @@
+// The delayed model (docs/effects.md §delay): the drive is D(t) = sat(K(θR − θo(t − τ))) + T0
+// with θo(t − τ) read from the history of the simulation itself (θo(s) = θo(0) for s < 0).
+// No closed form exists, so every mode is integrated by the method of steps:
+//   – runge_kutta_dopri5 with step control, each step ≤ τ (so D on the step needs only the
+//     history already computed) and ≤ 0.1/(fastest rate), landing exactly on the
+//     breakpoints t_event + τ, t_event + 2τ where the delayed signal's derivatives jump,
+//     and on the times where the delayed demand K(θR − θo(t − τ)) crosses ±L;
+//   – the history is stored as quintic Hermite pieces (θo, θ̇o, θ̈o at each step's ends:
+//     O(h⁶) between them, below the integrator's own error);
+//   – guards are the engine's witnesses with the drive as an input (w = row·z + c + k·D(t)),
+//     sampled inside each step on the step's quintic Hermite interpolant and refined with
+//     Boost.Math's toms748.
+// The mode logic — static rules, impacts, restitution, transitions — is the engine's, the
+// same as for the closed forms (effects_engine.cpp).  The odeint simulator
+// (odeint_effects_simulation.cpp) is an independent implementation of the same model.
+#include "effects/effects_engine.hpp"
+
+#include "backlash/numeric/scales.hpp"
+
+#include <boost/math/tools/roots.hpp>
+#include <boost/numeric/odeint.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+
+namespace backlash::numeric::detail {
+
+namespace {
+
+namespace odeint = boost::numeric::odeint;
+
+constexpr double tolerance = 1e-13;  // dopri5 absolute = relative error per step (1e-11 drifted 1e-10 s per s)
+constexpr int samples_per_step = 6;  // witness samples inside each step (plus its end)
+
+struct Jet {
+  double value = 0, rate = 0, acceleration = 0;
+};
+
+// The quintic Hermite interpolant on [t0, t0 + h] matching value, rate and acceleration at
+// both ends (error O(h⁶)).
+class Quintic {
+ public:
+  Quintic() = default;
+  Quintic(double t0, double t1, const Jet& y0, const Jet& y1) : t0_(t0), h_(t1 - t0) {
+    const double h = h_;
+    a_[0] = y0.value;
+    a_[1] = h * y0.rate;
+    a_[2] = h * h * y0.acceleration / 2;
+    const double r0 = y1.value - a_[0] - a_[1] - a_[2];
+    const double r1 = h * y1.rate - a_[1] - 2 * a_[2];
+    const double r2 = h * h * y1.acceleration - 2 * a_[2];
+    a_[3] = 10 * r0 - 4 * r1 + r2 / 2;
+    a_[4] = -15 * r0 + 7 * r1 - r2;
+    a_[5] = 6 * r0 - 3 * r1 + r2 / 2;
+  }
+  double start() const { return t0_; }
+  double end() const { return t0_ + h_; }
+  Jet at(double t) const {
+    if (h_ <= 0) return {a_[0], 0, 0};
+    const double s = (t - t0_) / h_;
+    double v = a_[5], d = 5 * a_[5], dd = 20 * a_[5];
+    for (int k = 4; k >= 0; --k) v = v * s + a_[k];
+    for (int k = 4; k >= 1; --k) d = d * s + k * a_[k];
+    for (int k = 4; k >= 2; --k) dd = dd * s + k * (k - 1) * a_[k];
+    return {v, d / h_, dd / (h_ * h_)};
+  }
+
+ private:
+  double t0_ = 0, h_ = 0;
+  std::array<double, 6> a_{};
+};
+
+// The history of θo and the delayed drive read from it.
+class DelayLine {
+ public:
+  DelayLine(const Parameters& p, const Effects& e, double theta_o0) : p_(p), e_(e), initial_(theta_o0) {}
+
+  double end() const { return pieces_.empty() ? 0.0 : pieces_.back().end(); }
+  double last_motion() const { return last_motion_; }
+
+  /// Appends θo on [t0, t1]; anything recorded beyond t0 is dropped first.
+  void append(double t0, double t1, const Jet& y0, const Jet& y1) {
+    while (!pieces_.empty() && pieces_.back().start() >= t0) pieces_.pop_back();
+    if (!(t1 > t0)) return;
+    pieces_.emplace_back(t0, t1, y0, y1);
+    if (y0.rate != 0 || y1.rate != 0 || y0.value != y1.value) last_motion_ = std::max(last_motion_, t1);
+    schedule_regime_changes(pieces_.back());
+  }
+
+  Jet theta_o(double s) const {
+    if (s <= 0 || pieces_.empty()) return {initial_, 0, 0};
+    std::size_t k = std::min(cursor_, pieces_.size() - 1);
+    while (k > 0 && pieces_[k].start() > s) --k;
+    while (k + 1 < pieces_.size() && pieces_[k].end() < s) ++k;
+    cursor_ = k;
+    return pieces_[k].at(std::min(s, pieces_[k].end()));
+  }
+
+  double demand(double t) const { return p_.K * (p_.theta_R - theta_o(t - e_.delay).value); }
+  int regime(double t) const {
+    if (!e_.saturating()) return 0;
+    const double d = demand(t);
+    return d > e_.saturation ? 1 : d < -e_.saturation ? -1 : 0;
+  }
+  /// D(t) and its first two derivatives.
+  Jet drive(double t) const {
+    const Jet y = theta_o(t - e_.delay);
+    const double d = p_.K * (p_.theta_R - y.value);
+    if (e_.saturating() && std::fabs(d) > e_.saturation) return {std::copysign(e_.saturation, d) + e_.torque_offset, 0, 0};
+    return {d + e_.torque_offset, -p_.K * y.rate, -p_.K * y.acceleration};
+  }
+
+  /// The times where the delayed demand crosses ±L, with the regime after each.
+  const std::map<double, int>& regime_changes() const { return changes_; }
+  /// The first such time after t (infinity if none is known yet: the history may add some).
+  double next_change_after(double t) const {
+    const auto c = changes_.upper_bound(t + 1e-12 * std::max(1.0, std::fabs(t)));
+    return c == changes_.end() ? INFINITY : c->first;
+  }
+
+ private:
+  // θo crossing θR ∓ L/K at s makes the demand at s + τ cross ±L.
+  void schedule_regime_changes(const Quintic& piece) {
+    if (!e_.saturating()) return;
+    for (int level_sign : {1, -1}) {
+      const double level = p_.theta_R - level_sign * e_.saturation / p_.K;  // demand = level_sign·L there
+      auto f = [&](double s) { return piece.at(s).value - level; };
+      double a = piece.start(), fa = f(a);
+      for (int k = 1; k <= 8; ++k) {
+        const double b = piece.start() + (piece.end() - piece.start()) * k / 8, fb = f(b);
+        if ((fa < 0 && fb >= 0) || (fa > 0 && fb <= 0)) {
+          std::uintmax_t iterations = 100;
+          const auto r = boost::math::tools::toms748_solve(f, a, b, fa, fb, boost::math::tools::eps_tolerance<double>(50),
+                                                           iterations);
+          const double s = 0.5 * (r.first + r.second);
+          // θo falling through θR − L/K: the demand rises through +L (clipped high), and so on.
+          const bool entering = level_sign > 0 ? fb < fa : fb > fa;
+          changes_[s + e_.delay] = entering ? level_sign : 0;
+        }
+        a = b;
+        fa = fb;
+      }
+    }
+  }
+
+  const Parameters& p_;
+  const Effects& e_;
+  double initial_;
+  std::vector<Quintic> pieces_;
+  mutable std::size_t cursor_ = 0;
+  double last_motion_ = 0;
+  std::map<double, int> changes_;
+};
+
+using Vector = std::array<double, 4>;
+
+double fastest_rate_with_mesh(const Parameters& p, const Effects& e) {
+  double rate = fastest_mode_rate(p);
+  if (e.compliant())
+    rate = std::max(rate, std::sqrt(e.mesh_stiffness * (1 / p.Jm + 1 / p.JL)) + e.mesh_damping * (1 / p.Jm + 1 / p.JL));
+  return rate;
+}
+
+// One mode integrated from the engine's state, with its guards.
+class DelayedSegment final : public Segment {
+ public:
+  DelayedSegment(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start, double t0,
+                 double horizon, double stop_at, DelayLine& line)
+      : p_(p), e_(e), m_(m), start_(start), t0_(t0), line_(line) {
+    sys_ = mode_system(p, e, m, start, true);
+    n_ = static_cast<int>(sys_.segment.A.rows());
+    functionals_.dimension = n_;
+    functionals_.theta_o_error = theta_o_error();
+    functionals_.gap = gap();
+    functionals_.drive = Functional{SmallRow::Zero(n_), 0, 0, 1};
+    witnesses_ = mode_witnesses(p, e, m, functionals_, false);
+    const double stop = std::min(t0 + horizon, stop_at);
+    const bool stuck = m.kind == ModeKind::Contact ? m.slip_motor == 0 : (m.slip_motor == 0 && m.slip_load == 0);
+    if (stuck)
+      hold_still(stop);
+    else
+      integrate(stop);
+    finish_at(stop);
+  }
+
+  HybridState state(double tau) const override { return state_of(z_at(t0_ + tau)); }
+
+  void extremes(double until, Extremes& x) const override {
+    include(state(0), x);
+    include(state(until), x);
+    const std::vector<int> rows = m_.kind == ModeKind::Contact ? std::vector<int>{1} : std::vector<int>{1, 3};
+    for (const Step& step : steps_) {
+      const double b_end = std::min(step.t1, t0_ + until);
+      if (!(b_end > step.t0)) break;
+      for (int row : rows) {
+        auto v = [&](double t) { return step.z[row].at(t).value; };
+        double a = step.t0, va = v(a);
+        for (int k = 1; k <= samples_per_step; ++k) {
+          const double b = step.t0 + (b_end - step.t0) * k / samples_per_step, vb = v(b);
+          if ((va < 0 && vb >= 0) || (va > 0 && vb <= 0)) {
+            std::uintmax_t iterations = 100;
+            const auto r = boost::math::tools::toms748_solve(v, a, b, va, vb, boost::math::tools::eps_tolerance<double>(50),
+                                                             iterations);
+            include(state(0.5 * (r.first + r.second) - t0_), x);
+          }
+          a = b;
+          va = vb;
+        }
+      }
+    }
+  }
+
+ private:
+  struct Step {
+    double t0, t1;
+    std::array<Quintic, 4> z;
+  };
+
+  Functional theta_o_error() const {
+    Functional f{SmallRow::Zero(n_), measured(p_, start_) - p_.theta_R,
+                 std::fabs(measured(p_, start_)) + std::fabs(p_.theta_R), 0};
+    f.row(m_.kind == ModeKind::Contact ? 0 : (p_.measured_at == model::MeasuredAt::Motor ? 0 : 2)) = 1;
+    return f;
+  }
+  Functional gap() const {
+    Functional f{SmallRow::Zero(n_), 0, 0, 0};
+    if (m_.kind == ModeKind::Contact) {
+      f.constant = m_.face * p_.backlash / 2;
+      f.magnitude = p_.backlash / 2;
+    } else {
+      f.row(0) = -1;
+      f.row(2) = 1;
+      f.constant = start_.theta_L - start_.theta_m;
+      f.magnitude = std::fabs(start_.theta_L) + std::fabs(start_.theta_m);
+      for (int face : {-1, 1})  // a flight placed on a face starts exactly there (effect_modes.cpp)
+        if (std::fabs(f.constant - face * p_.backlash / 2) <= 8 * std::numeric_limits<double>::epsilon() * f.magnitude)
+          f.constant = face * p_.backlash / 2;
+    }
+    return f;
+  }
+
+  // z' and z'' from z at time t: z' = A z + c + b D(t), z'' = A z' + b D'(t).
+  std::pair<SmallVector, SmallVector> derivatives(const SmallVector& z, double t) const {
+    const Jet d = line_.drive(t);
+    const SmallVector z1 = sys_.segment.A * z + sys_.segment.c + sys_.drive_column * d.value;
+    const SmallVector z2 = sys_.segment.A * z1 + sys_.drive_column * d.rate;
+    return {z1, z2};
+  }
+
+  double witness_value(const Witness& w, const SmallVector& z, double t) const {
+    double sum = w.f.constant;
+    for (int i = 0; i < n_; ++i) sum += w.f.row(i) * z(i);
+    return w.f.drive_weight != 0 ? sum + w.f.drive_weight * line_.drive(t).value : sum;
+  }
+
+  SmallVector z_at(double t) const {
+    if (steps_.empty() || t <= steps_.front().t0) return sys_.z0;
+    auto it = std::upper_bound(steps_.begin(), steps_.end(), t, [](double x, const Step& s) { return x < s.t1; });
+    const Step& step = it == steps_.end() ? steps_.back() : *it;
+    SmallVector z(n_);
+    for (int i = 0; i < n_; ++i) z(i) = step.z[i].at(std::min(t, step.t1)).value;
+    return z;
+  }
+
+  HybridState state_of(const SmallVector& z) const {
+    HybridState h;
+    if (m_.kind == ModeKind::Contact) {
+      h = state_on_face(p_, m_.face, measured(p_, start_) + z(0), z(1), true);
+      h.motor_stuck = h.load_stuck = m_.slip_motor == 0;
+    } else {
+      h.theta_m = start_.theta_m + z(0);
+      h.dtheta_m = z(1);
+      h.theta_L = start_.theta_L + z(2);
+      h.dtheta_L = z(3);
+      h.in_contact = m_.kind == ModeKind::Mesh;
+      h.face = m_.face;
+      h.motor_stuck = m_.slip_motor == 0;
+      h.load_stuck = m_.slip_load == 0;
+    }
+    h.drive_regime = start_.drive_regime;
+    return h;
+  }
+
+  Jet theta_o_jet(const SmallVector& z, const SmallVector& z1, const SmallVector& z2) const {
+    const int i = m_.kind == ModeKind::Contact ? 0 : (p_.measured_at == model::MeasuredAt::Motor ? 0 : 2);
+    return {measured(p_, start_) + z(i), z1(i), z2(i)};
+  }
+
+  // Whether each witness is armed at the start (valid side), exits at once, departs from its
+  // boundary inward with a non-zero rate (armed from its first positive sample: a tiny
+  // bounce's return is an event however small), or waits until it is clearly inside.
+  enum class Arming { Armed, ExitNow, Departing, Waiting };
+  Arming arm(const Witness& w, double& tolerance_out) const {
+    const auto [z1, z2] = derivatives(sys_.z0, t0_);
+    const Jet d = line_.drive(t0_);
+    const double w0 = witness_value(w, sys_.z0, t0_);
+    const double w1 = w.f.row.dot(z1) + w.f.drive_weight * d.rate;
+    // On the boundary: within the rounding of its terms, or what the previous event's time
+    // tolerance moves it (as the closed-form engine, effects_simulation.cpp).
+    const double tol = 64 * std::numeric_limits<double>::epsilon() *
+                           (w.f.row.cwiseAbs().dot(sys_.z0.cwiseAbs().transpose()) + w.f.magnitude +
+                            std::fabs(w.f.drive_weight * d.value)) +
+                       32 * w.f.row.cwiseAbs().dot(sys_.z0_noise.transpose()) + std::fabs(w1) * 4e-14 * std::max(1.0, t0_);
+    tolerance_out = tol;
+    if (w0 > tol) return Arming::Armed;
+    if (w0 < -tol) return Arming::ExitNow;
+    const double s1 = w.f.row.cwiseAbs().dot((sys_.segment.A.cwiseAbs() * (sys_.z0.cwiseAbs() + sys_.z0_noise) +
+                                              sys_.c_magnitude + sys_.drive_column.cwiseAbs() * std::fabs(d.value))
+                                                 .transpose()) +
+                      std::fabs(w.f.drive_weight * d.rate);
+    if (std::fabs(w1) > 1e-9 * s1) return w1 < 0 ? Arming::ExitNow : Arming::Departing;
+    const double w2 = w.f.row.dot(z2) + w.f.drive_weight * d.acceleration;
+    if (w2 < 0 && std::fabs(w2) > 1e-9 * (s1 + std::fabs(w.f.drive_weight * d.acceleration))) return Arming::ExitNow;
+    return Arming::Waiting;
+  }
+
+  // Everything stuck: only the delayed drive moves; the history stays at the current θo.
+  void hold_still(double stop) {
+    const double quiet = line_.last_motion() + e_.delay;
+    std::vector<double> tolerances(witnesses_.size());
+    for (std::size_t i = 0; i < witnesses_.size(); ++i) {
+      if (arm(witnesses_[i], tolerances[i]) == Arming::ExitNow) {
+        exit = Exit{0, witnesses_[i], false};
+        return;
+      }
+    }
+    const double until = std::min(stop, std::max(quiet, t0_));
+    const int samples = std::max(8, static_cast<int>(std::ceil((until - t0_) / (0.02 * std::max(e_.delay, 1e-6)))));
+    double a = t0_;
+    for (int k = 1; k <= samples && until > t0_; ++k) {
+      const double b = t0_ + (until - t0_) * k / samples;
+      for (const Witness& w : witnesses_) {
+        auto f = [&](double t) { return witness_value(w, sys_.z0, t); };
+        const double fa = f(a), fb = f(b);
+        if (fa >= 0 && fb < 0) {
+          std::uintmax_t iterations = 100;
+          const auto r = boost::math::tools::toms748_solve(f, a, b, fa, fb, boost::math::tools::eps_tolerance<double>(50),
+                                                           iterations);
+          const double t = 0.5 * (r.first + r.second);
+          if (!exit || t - t0_ < exit->tau) exit = Exit{t - t0_, w, false};
+        }
+      }
+      if (exit) break;
+      a = b;
+    }
+    const double end = exit ? t0_ + exit->tau : stop;
+    const Jet still{measured(p_, start_), 0, 0};
+    line_.append(t0_, end, still, still);
+    if (!exit && quiet <= stop) rest = true;
+  }
+
+  void integrate(double stop) {
+    const double dt_max = std::min(e_.delay, 0.1 / fastest_rate_with_mesh(p_, e_));
+    std::vector<Arming> arming(witnesses_.size());
+    std::vector<double> tolerances(witnesses_.size());
+    for (std::size_t i = 0; i < witnesses_.size(); ++i) {
+      arming[i] = arm(witnesses_[i], tolerances[i]);
+      if (arming[i] == Arming::ExitNow) {
+        exit = Exit{0, witnesses_[i], false};
+        return;
+      }
+    }
+    auto rhs = [this](const Vector& x, Vector& dx, double t) {
+      const double drive = line_.drive(t).value;
+      for (int i = 0; i < n_; ++i) {
+        double sum = sys_.segment.c(i) + sys_.drive_column(i) * drive;
+        for (int j = 0; j < n_; ++j) sum += sys_.segment.A(i, j) * x[j];
+        dx[i] = sum;
+      }
+      for (int i = n_; i < 4; ++i) dx[i] = 0;
+    };
+    auto stepper = odeint::make_controlled(tolerance, tolerance, odeint::runge_kutta_dopri5<Vector>());
+    Vector x{};
+    for (int i = 0; i < n_; ++i) x[i] = sys_.z0(i);
+    SmallVector za = sys_.z0;
+    auto [za1, za2] = derivatives(za, t0_);
+    // A witness that leaves its boundary inward but curves back (w' > 0 > w'') returns after
+    // about 2w'/|w''|: the first step is kept well below that, so its samples see the flight.
+    double dt = std::min(dt_max, std::max(1e-6, 1e-3 * dt_max));
+    for (std::size_t i = 0; i < witnesses_.size(); ++i) {
+      if (arming[i] != Arming::Departing && arming[i] != Arming::Waiting) continue;
+      double w1 = witnesses_[i].f.drive_weight * line_.drive(t0_).rate, w2 = witnesses_[i].f.drive_weight * line_.drive(t0_).acceleration;
+      for (int j = 0; j < n_; ++j) w1 += witnesses_[i].f.row(j) * za1(j), w2 += witnesses_[i].f.row(j) * za2(j);
+      if (w1 > 0 && w2 < 0) dt = std::min(dt, 0.25 * w1 / -w2);
+    }
+    double t = t0_;
+    while (t < stop && !exit) {
+      const double ta = t;
+      // Stop on a change of the delayed drive's regime the history has just revealed.
+      const double end = std::min(stop, line_.next_change_after(t));
+      double trial = std::min({dt, dt_max, end - t});
+      if (end - t - trial < 1e-12 * std::max(1.0, end)) trial = end - t;
+      if (stepper.try_step(rhs, x, t, trial) != odeint::success) {
+        dt = trial;
+        continue;
+      }
+      dt = trial;  // the stepper proposes the next step in `trial`
+      if (t > end || end - t < 1e-12 * std::max(1.0, end)) t = end;
+      SmallVector zb(n_);
+      for (int i = 0; i < n_; ++i) zb(i) = x[i];
+      const auto [zb1, zb2] = derivatives(zb, t);
+      Step step{ta, t, {}};
+      for (int i = 0; i < n_; ++i) step.z[i] = Quintic(ta, t, {za(i), za1(i), za2(i)}, {zb(i), zb1(i), zb2(i)});
+      steps_.push_back(step);
+      const double kept_until = check_step(steps_.back(), arming, tolerances);
+      const Step& kept = steps_.back();
+      SmallVector ze(n_), ze1(n_), ze2(n_);
+      for (int i = 0; i < n_; ++i) {
+        const Jet j = kept.z[i].at(kept_until);
+        ze(i) = j.value;
+        ze1(i) = j.rate;
+        ze2(i) = j.acceleration;
+      }
+      line_.append(ta, kept_until, theta_o_jet(za, za1, za2), theta_o_jet(ze, ze1, ze2));
+      za = zb;
+      za1 = zb1;
+      za2 = zb2;
+      if (!exit && t == end && end < stop) regime_change(end);
+    }
+  }
+
+  // The delayed drive enters or leaves its limit at t: an exit of this segment.
+  void regime_change(double t) {
+    const auto change = line_.regime_changes().find(t);
+    if (change == line_.regime_changes().end()) return;
+    const int regime = change->second;
+    const Guard guard = regime > 0 ? Guard::DriveHigh : regime < 0 ? Guard::DriveLow : Guard::DriveLeave;
+    exit = Exit{t - t0_, Witness{guard, 0, Functional{SmallRow::Zero(n_), 0, 0, 0}}, false};
+  }
+
+  // Witness exits inside a step, on its interpolant; returns the end of the step that is kept.
+  double check_step(const Step& step, std::vector<Arming>& arming, const std::vector<double>& tolerances) {
+    auto z_of = [&step, this](double t) {
+      SmallVector z(n_);
+      for (int i = 0; i < n_; ++i) z(i) = step.z[i].at(t).value;
+      return z;
+    };
+    double a = step.t0;
+    std::vector<double> wa(witnesses_.size());
+    for (std::size_t i = 0; i < witnesses_.size(); ++i) wa[i] = witness_value(witnesses_[i], z_of(a), a);
+    for (int k = 1; k <= samples_per_step; ++k) {
+      const double b = k == samples_per_step ? step.t1 : step.t0 + (step.t1 - step.t0) * k / samples_per_step;
+      const SmallVector zb = z_of(b);
+      std::optional<Exit> first;
+      for (std::size_t i = 0; i < witnesses_.size(); ++i) {
+        const Witness& w = witnesses_[i];
+        const double wb = witness_value(w, zb, b);
+        if (arming[i] == Arming::Armed && wa[i] >= 0 && wb < 0) {
+          auto f = [&](double t) { return witness_value(w, z_of(t), t); };
+          std::uintmax_t iterations = 100;
+          const auto r = boost::math::tools::toms748_solve(f, a, b, wa[i], wb,
+                                                           boost::math::tools::eps_tolerance<double>(50), iterations);
+          const double t = 0.5 * (r.first + r.second);
+          if (!first || t - t0_ < first->tau) first = Exit{t - t0_, w, false};
+        }
+        if ((arming[i] == Arming::Waiting && wb > tolerances[i]) || (arming[i] == Arming::Departing && wb > 0))
+          arming[i] = Arming::Armed;
+        wa[i] = wb;
+      }
+      if (first) {
+        exit = first;
+        steps_.back().t1 = t0_ + first->tau;
+        return steps_.back().t1;
+      }
+      a = b;
+    }
+    return step.t1;
+  }
+
+  void finish_at(double stop) {
+    if (exit) {
+      duration = exit->tau;
+      return;
+    }
+    duration = stop - t0_;
+    if (rest) return;
+    regime_change(stop);
+    if (exit) duration = exit->tau;
+  }
+
+  void include(const HybridState& h, Extremes& x) const { include_extremes(p_, h, x); }
+
+  const Parameters& p_;
+  const Effects& e_;
+  Mode m_;
+  HybridState start_;
+  double t0_;
+  DelayLine& line_;
+  ModeSystem sys_;
+  int n_ = 4;
+  ModeFunctionals functionals_;
+  std::vector<Witness> witnesses_;
+  std::vector<Step> steps_;
+};
+
+class DelayedEngine final : public Engine {
+ public:
+  DelayedEngine(const Parameters& p, const Effects& e, const SimulationOptions& options,
+                const EffectsEngineOptions& engine, double theta_o0)
+      : Engine(p, e, options, engine), line_(p, e, theta_o0) {
+    breakpoints_.insert(e.delay);
+    breakpoints_.insert(2 * e.delay);
+  }
+
+ protected:
+  double drive_now() const override { return line_.drive(t_).value; }
+
+  std::unique_ptr<Segment> next_segment(const Mode& mode, double remaining) override {
+    for (; events_seen_ < result_.events.size(); ++events_seen_) {
+      const double t = result_.events[events_seen_].t;
+      breakpoints_.insert(t + e_.delay);
+      breakpoints_.insert(t + 2 * e_.delay);
+    }
+    // The regime the drive is in now (a change at exactly t_ has been reported already).
+    const Mode m = mode;
+    double stop = t_ + remaining;
+    const double slack = 1e-12 * std::max(1.0, t_);
+    if (auto b = breakpoints_.upper_bound(t_ + slack); b != breakpoints_.end()) stop = std::min(stop, *b);
+    const auto& changes = line_.regime_changes();
+    if (auto c = changes.upper_bound(t_ + slack); c != changes.end()) stop = std::min(stop, c->first);
+    return std::make_unique<DelayedSegment>(p_, e_, m, state_, t_, remaining, stop, line_);
+  }
+
+ private:
+  DelayLine line_;
+  std::set<double> breakpoints_;
+  std::size_t events_seen_ = 0;
+};
+
+}  // namespace
+
+SimulationResult simulate_delayed(const Parameters& p, const Effects& e, const HybridState& start,
+                                  const SimulationOptions& options, const EffectsEngineOptions& engine) {
+  HybridState s = start;
+  s.drive_regime = drive_regime(p, e, measured(p, start));
+  return DelayedEngine(p, e, options, engine, measured(p, start)).run(s);
+}
+
+}  // namespace backlash::numeric::detail

@@ -1,0 +1,148 @@
+// numeric/effects/effects_engine.hpp (internal) — the event loop of the hybrid model
+// with effects, shared by its two ways of moving through a mode:
+//   closed forms (effects_simulation.cpp: every mode without delay) and
+//   the delayed model integrated by the method of steps (effects_delay.cpp).
+// The engine owns what is the same for both (docs/effects.md): the modes a state is
+// in, the static rules (sticking, break-away, the pair's band), impacts with
+// restitution and the summed bounce series, the transitions and their events, the
+// rest rules, the statuses.  A subclass supplies the drive torque now and each
+// segment: the motion in the current mode up to its first exit.
+#pragma once
+
+#include "effects/effect_modes.hpp"
+#include "backlash/numeric/effects.hpp"
+#include "backlash/numeric/effects_engine_options.hpp"
+#include "backlash/numeric/first_crossing.hpp"
+#include "backlash/numeric/hybrid_simulation.hpp"
+
+#include <deque>
+#include <memory>
+#include <optional>
+#include <vector>
+
+namespace backlash::numeric::detail {
+
+enum class Guard {
+  ContactTorque,   // rigid contact: −σ·Tc ≥ 0
+  PairVelocity,    // rigid contact: s·ω ≥ 0
+  DriveHigh,       // linear drive: L − K(θR − θo) ≥ 0
+  DriveLow,        // linear drive: L + K(θR − θo) ≥ 0
+  DriveLeave,      // clipped drive: r·K(θR − θo) − L ≥ 0
+  GapOpposite,     // free, rigid: σ·x + b/2 ≥ 0
+  GapSame,         // free, rigid: b/2 − σ·x ≥ 0
+  MotorVelocity,   // s_m·θ̇m ≥ 0
+  LoadVelocity,    // s_L·θ̇L ≥ 0
+  MotorBreakHigh,  // stuck motor: Tm − N ≥ 0
+  MotorBreakLow,   // stuck motor: Tm + N ≥ 0
+  LoadBreakHigh,   // stuck load (mesh): TL − N ≥ 0
+  LoadBreakLow,    // stuck load (mesh): TL + N ≥ 0
+  PairBreakPush,   // stuck pair (delay): the drive beyond the band's pushing edge
+  PairBreakPull,   // stuck pair (delay): the drive beyond the band's pulling edge
+  MeshRelease,     // mesh on face σ: P ≥ 0
+  EngageFace,      // free, compliant: −δ_φ ≥ 0 (teeth apart)
+  EngageForce,     // free, compliant, teeth overlapping: −P_φ ≥ 0
+  ZoneExit,        // free, compliant, teeth overlapping: δ_φ ≥ 0
+};
+
+/// row·z + constant + drive_weight·D(t) in a mode's local coordinates; `magnitude` is the size
+/// of the terms the constant was formed from (its rounding scale).  Closed-form modes fold
+/// the drive into row and constant (drive_weight = 0); the delayed model keeps it apart.
+struct Functional {
+  SmallRow row;
+  double constant = 0;
+  double magnitude = 0;
+  double drive_weight = 0;
+  Functional scaled(double k) const { return {row * k, constant * k, magnitude * std::fabs(k), drive_weight * k}; }
+  Functional plus(const Functional& o) const {
+    return {row + o.row, constant + o.constant, magnitude + o.magnitude, drive_weight + o.drive_weight};
+  }
+  Functional shifted(double c) const { return {row, constant + c, magnitude + std::fabs(c), drive_weight}; }
+};
+
+/// A guard: valid while its functional is ≥ 0; the event is its first exit.
+struct Witness {
+  Guard guard;
+  int face = 0;  ///< the face a gap/engagement guard concerns
+  Functional f;
+};
+
+struct Exit {
+  double tau = 0;
+  Witness witness;
+  bool grazing = false;
+};
+
+/// The guards of a mode that do not involve the drive's regime (gap, velocity zeros,
+/// break-away, mesh), given the functionals of the mode's coordinates.
+struct ModeFunctionals {
+  Functional theta_o_error, gap, drive;  ///< θo − θR, θL − θm, the drive torque D
+  int dimension = 4;
+};
+std::vector<Witness> mode_witnesses(const Parameters& p, const Effects& e, const Mode& m, const ModeFunctionals& f,
+                                    bool with_drive_limits);
+
+/// The motion in one mode from the engine's current state.
+class Segment {
+ public:
+  virtual ~Segment() = default;
+  virtual HybridState state(double tau) const = 0;
+  /// Adds the extremes of θo, θm, θL over [0, duration] (ends and velocity zeros).
+  virtual void extremes(double duration, Extremes& x) const = 0;
+  std::optional<Exit> exit;  ///< the first exit before the horizon
+  double duration = 0;       ///< exit->tau, the horizon, or a breakpoint of the delayed model
+  bool rest = false;         ///< everything stuck and nothing can move any more
+};
+
+class Engine {
+ public:
+  Engine(const Parameters& p, const Effects& e, const SimulationOptions& options, const EffectsEngineOptions& engine);
+  virtual ~Engine() = default;
+  SimulationResult run(const HybridState& start);
+
+ protected:
+  /// The drive torque D at the current time (a state, or the delayed history).
+  virtual double drive_now() const = 0;
+  /// The segment of `mode` from state_ at t_, over at most `remaining`.
+  virtual std::unique_ptr<Segment> next_segment(const Mode& mode, double remaining) = 0;
+  /// Called after every event and segment (the delayed model records its history).
+  virtual void advanced(double /*t_from*/, const Segment* /*segment*/) {}
+
+  Mode mode_of(const HybridState& s) const;
+  double motor_static_torque(const HybridState& s) const;
+  double load_static_torque(const HybridState& s) const;
+  double contact_torque(const Mode& m, const HybridState& s) const;
+
+  const Parameters& p_;
+  const Effects& e_;
+  const SimulationOptions& o_;
+  const EffectsEngineOptions engine_;
+  SimulationResult result_;
+  TrajectoryRecorder recorder_;
+  HybridState state_;
+  double t_ = 0;
+
+ private:
+  SimulationResult finish(SimulationStatus status);
+  void push(EventKind kind, Body body = Body::None, bool bounce = false, bool grazing = false, bool accumulation = false);
+  bool at_rest(const Mode& m) const;
+  void settle();
+  void settle_contact();
+  void settle_body(bool motor);
+  void transition(const Exit& exit, const Mode& m);
+  void impact(const Exit& exit);
+  void count_impact();
+  double closing_acceleration(int face) const;
+  bool accumulate(int face, double alpha, const HybridState& before);
+  bool contact_holds(const HybridState& s) const;
+  bool rests_in_free_flight(const Mode& m, const Segment& segment, double remaining);
+
+  long separations_ = 0;
+  bool stop_reached_ = false;  ///< the event of engine_.stop_at_kind / stop_at_face happened
+  std::deque<double> impacts_;
+};
+
+/// The delayed model (Boost.Odeint, method of steps): effects_delay.cpp.
+SimulationResult simulate_delayed(const Parameters& p, const Effects& e, const HybridState& start,
+                                  const SimulationOptions& options, const EffectsEngineOptions& engine);
+
+}  // namespace backlash::numeric::detail

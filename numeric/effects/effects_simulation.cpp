@@ -1,0 +1,259 @@
+// The closed-form hybrid simulator with effects (effects_simulation.hpp,
+// docs/effects.md): each segment is a mode's closed-form flow (effect_modes.cpp)
+// and the first certified exit among its witnesses; the event loop, the static
+// rules and the impacts are the engine's (effects_engine.cpp).
+#include "backlash/numeric/effects_simulation.hpp"
+
+#include "effects/effects_engine.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <optional>
+
+namespace backlash::numeric {
+
+namespace {
+
+using detail::Exit;
+using detail::Functional;
+using detail::Guard;
+using detail::Witness;
+
+Functional of(const ModeFlow::Functional& f) { return {f.row, f.constant, f.magnitude, 0}; }
+
+// The closed-form mode's coordinates as functionals: θo − θR, the gap, and the drive folded in.
+detail::ModeFunctionals functionals_of(const Parameters& p, const Effects& e, const ModeFlow& flow) {
+  detail::ModeFunctionals f;
+  f.theta_o_error = of(flow.theta_o_error());
+  f.gap = of(flow.gap_functional());
+  f.dimension = static_cast<int>(flow.segment().A.rows());
+  if (flow.mode().regime == 0)
+    f.drive = f.theta_o_error.scaled(-p.K).shifted(e.torque_offset);
+  else
+    f.drive = Functional{SmallRow::Zero(f.dimension), flow.mode().regime * e.saturation + e.torque_offset,
+                         e.saturation + std::fabs(e.torque_offset), 0};
+  return f;
+}
+
+double factorial(int n) { return n <= 1 ? 1.0 : n * factorial(n - 1); }
+
+// A witness on its boundary at τ = 0 leaves it toward w > 0 (its first derivative that is not
+// rounding noise is positive): the largest τ0 = horizon/2^i where the Taylor lower bound
+//   w(τ) ≥ w_K τ^K/K! − Σ_{j<K} |w_j| τ^j/j! − sup|w^{(K+1)}| τ^{K+1}/(K+1)!
+// is positive, sup|w^{(K+1)}| ≤ ‖e A^K‖₁ e^{‖A‖τ} ‖ż(0)‖∞.  0 when none is found.
+double departure_time(const LinearWitness& lw, const SmallVector& zdot0, const std::array<double, 4>& w, int K,
+                      double horizon) {
+  SmallRow eAK = lw.e;
+  for (int k = 0; k < K; ++k) eAK = eAK * lw.A;
+  const double norm_A = lw.A.cwiseAbs().rowwise().sum().maxCoeff(), norm_z = zdot0.cwiseAbs().maxCoeff();
+  const double norm_eAK = eAK.cwiseAbs().sum();
+  double tau = horizon;
+  for (int i = 0; i < 400 && tau > 0; ++i, tau *= 0.5) {
+    std::array<double, 5> power{1, tau, tau * tau, tau * tau * tau, tau * tau * tau * tau};
+    double lower = w[K] * power[K] / factorial(K) -
+                   norm_eAK * std::exp(norm_A * tau) * norm_z * power[K + 1] / factorial(K + 1);
+    for (int j = 0; j < K; ++j) lower -= std::fabs(w[j]) * power[j] / factorial(j);
+    if (lower > 0) return tau;
+  }
+  return 0;
+}
+
+enum class StartKind { Inside, ExitNow, Never };
+struct Start {
+  StartKind kind = StartKind::Inside;
+  double from = 0;
+};
+
+// Where the search for a witness's exit starts.  Rounding scales come from the size of the
+// terms that formed each quantity (a deviation or a forcing can cancel): w(0) is on its
+// boundary when within the rounding of its terms, or within what the previous event's time
+// tolerance (toms748: 1e-14 of t) moves it; a derivative is noise below 1e-9 of its terms'.
+// (A looser on-boundary rule — 1e-11 of the terms — took a real 1e-11 gap for a contact.)
+// On the boundary, the first derivative that is not noise decides: leaving the valid side is
+// an exit at once, entering it starts the search after a certified departure time.
+Start classify_start(const ModeFlow& flow, const LinearWitness& lw, double magnitude, double horizon, double t_global) {
+  const SmallVector& z0 = flow.local_start();
+  const SmallVector& z0_noise = flow.local_start_noise();
+  const SmallVector zdot = lw.A * z0 + lw.c;
+  const SmallVector zdot_scale = lw.A.cwiseAbs() * (z0.cwiseAbs() + z0_noise) + flow.forcing_magnitude();
+  std::array<double, 4> w{};
+  std::array<double, 4> scale{};
+  w[0] = lw.e.dot(z0) - lw.level;
+  SmallRow e = lw.e;
+  for (int k = 1; k <= 3; ++k) {
+    w[k] = e.dot(zdot);
+    scale[k] = e.cwiseAbs().dot(zdot_scale.transpose());
+    e = e * lw.A;
+  }
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  const double tolerance = 64 * eps * (lw.e.cwiseAbs().dot(z0.cwiseAbs().transpose()) + magnitude) +
+                           32 * lw.e.cwiseAbs().dot(z0_noise.transpose()) +
+                           std::fabs(w[1]) * 4e-14 * std::max(1.0, std::fabs(t_global));
+  if (w[0] > tolerance) return {StartKind::Inside, 0};
+  if (w[0] < -tolerance) return {StartKind::ExitNow, 0};
+  for (int K = 1; K <= 3; ++K) {
+    if (std::fabs(w[K]) <= 1e-9 * scale[K]) continue;
+    if (w[K] < 0) return {StartKind::ExitNow, 0};
+    const double from = departure_time(lw, zdot, w, K, horizon);
+    return {StartKind::Inside, from > 0 ? from : std::min(horizon, 1e-12 * std::max(1.0, horizon))};
+  }
+  return {StartKind::Never, 0};
+}
+
+bool grazing_is_event(Guard g) { return g == Guard::GapOpposite || g == Guard::GapSame; }
+
+// The rounding-level rule of the nominal simulators: a zero of Tc where the contact motion has
+// decayed to rounding level about its equilibrium is not a separation.
+bool spurious_separation(const Parameters& p, const ModeFlow& flow, double tau) {
+  const Mode& m = flow.mode();
+  if (m.kind != ModeKind::Contact || m.regime != 0) return false;
+  const SmallVector z = flow.local(tau);
+  const double noise = 1024 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(p.theta_R));
+  return std::fabs(z(0)) <= noise && std::fabs(z(1)) <= noise * std::sqrt(p.K / (p.Jm + p.JL));
+}
+
+// The certified search for one witness's first exit, advanced window by window.
+class ExitSearch {
+ public:
+  ExitSearch(const Parameters& p, const ModeFlow& flow, const Witness& witness, double horizon, double t_global)
+      : p_(p), flow_(flow), witness_(witness) {
+    lw_.A = flow.segment().A;
+    lw_.c = flow.segment().c;
+    lw_.e = witness.f.row;
+    lw_.level = -witness.f.constant;
+    lw_.state = [&flow](double tau) { return flow.local(tau); };
+    lw_.third_derivative_bound = flow.derivative_bound(lw_.e, 3);
+    const Start start = classify_start(flow, lw_, witness.f.magnitude, horizon, t_global);
+    if (start.kind == StartKind::Never) finished_ = true;
+    if (start.kind == StartKind::ExitNow) immediate_ = true;
+    from_ = start.from;
+  }
+
+  bool immediate() const { return immediate_; }
+
+  /// The first exit in (from, until], or nothing there (the search then resumes at `until`).
+  std::optional<Exit> search_until(double until) {
+    while (!finished_ && from_ < until) {
+      const std::optional<Crossing> crossing = first_crossing(lw_, from_, until);
+      if (!crossing) {
+        from_ = until;
+        return std::nullopt;
+      }
+      const bool spurious = witness_.guard == Guard::ContactTorque && spurious_separation(p_, flow_, crossing->t);
+      if (spurious && !crossing->grazing) {  // the contact motion has decayed to rounding: contact holds to the end
+        finished_ = true;
+        return std::nullopt;
+      }
+      if (!spurious && (!crossing->grazing || grazing_is_event(witness_.guard)))
+        return Exit{crossing->t, witness_, crossing->grazing};
+      from_ = crossing->t + 1e-12 * std::max(1.0, crossing->t);
+    }
+    return std::nullopt;
+  }
+
+ private:
+  const Parameters& p_;
+  const ModeFlow& flow_;
+  Witness witness_;
+  LinearWitness lw_;
+  double from_ = 0;
+  bool finished_ = false, immediate_ = false;
+};
+
+class ClosedFormSegment final : public detail::Segment {
+ public:
+  ClosedFormSegment(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start, double horizon,
+                    double t_global)
+      : params_(p), flow_(p, e, m, start) {
+    duration = horizon;
+    if (m.kind == ModeKind::Contact ? m.slip_motor == 0 : (m.slip_motor == 0 && m.slip_load == 0)) {
+      rest = true;  // everything stuck and no delay: the drive cannot change
+      return;
+    }
+    // Every witness searched window by window, the windows doubling from an eighth of the servo
+    // period: the search stops at the first window that holds an exit, never far beyond it.
+    std::vector<ExitSearch> searches;
+    for (const Witness& w : detail::mode_witnesses(p, e, m, functionals_of(p, e, flow_), true)) {
+      searches.emplace_back(p, flow_, w, horizon, t_global);
+      if (searches.back().immediate()) {
+        exit = Exit{0, w, false};
+        duration = 0;
+        return;
+      }
+    }
+    double window = std::min(horizon, 0.125 * servo_period(p));
+    for (double a = 0; a < horizon && !exit; a += window, window *= 2) {
+      const double b = std::min(horizon, a + window);
+      for (ExitSearch& search : searches) {
+        const std::optional<Exit> candidate = search.search_until(exit ? exit->tau : b);
+        if (candidate && (!exit || candidate->tau < exit->tau)) exit = candidate;
+      }
+    }
+    if (exit) duration = exit->tau;
+  }
+
+  HybridState state(double tau) const override { return flow_.state(tau); }
+
+  // The exact extremes: the ends and the certified zeros of each moving velocity.
+  void extremes(double until, Extremes& x) const override {
+    include(flow_.state(0), x);
+    include(flow_.state(until), x);
+    const Mode& m = flow_.mode();
+    std::vector<ModeFlow::Functional> velocities;
+    if (m.slip_motor != 0) velocities.push_back(flow_.motor_velocity());
+    if (m.kind != ModeKind::Contact && m.slip_load != 0) velocities.push_back(flow_.load_velocity());
+    for (const ModeFlow::Functional& v : velocities) {
+      LinearWitness w;
+      w.A = flow_.segment().A;
+      w.c = flow_.segment().c;
+      w.e = v.row;
+      w.level = -v.constant;
+      w.state = [this](double tau) { return flow_.local(tau); };
+      w.third_derivative_bound = flow_.derivative_bound(w.e, 3);
+      double from = 0;
+      for (int k = 0; k < 10000 && from < until; ++k) {
+        const auto zero = first_crossing(w, from, until);
+        if (!zero) break;
+        include(flow_.state(zero->t), x);
+        from = zero->t + 1e-12 * std::max(1.0, zero->t);
+      }
+    }
+  }
+
+ private:
+  void include(const HybridState& h, Extremes& x) const { include_extremes(params_, h, x); }
+  Parameters params_;
+  ModeFlow flow_;
+};
+
+class ClosedFormEngine final : public detail::Engine {
+ public:
+  using Engine::Engine;
+
+ protected:
+  double drive_now() const override {
+    return drive_torque_in_regime(p_, e_, measured(p_, state_), state_.drive_regime);
+  }
+  std::unique_ptr<detail::Segment> next_segment(const Mode& mode, double remaining) override {
+    return std::make_unique<ClosedFormSegment>(p_, e_, mode, state_, remaining, t_);
+  }
+};
+
+}  // namespace
+
+SimulationResult simulate_effects(const ValidatedEffectModel& model, const HybridState& start,
+                                  const SimulationOptions& options, const EffectsEngineOptions& engine) {
+  const Effects& e = model.effects();
+  if (!e.any() && !engine.general_engine) return simulate(model.nominal(), start, options);
+  if (e.delayed()) return detail::simulate_delayed(model.parameters(), e, start, options, engine);
+  return ClosedFormEngine(model.parameters(), e, options, engine).run(start);
+}
+
+SimulationResult simulate_effects_step(const ValidatedEffectModel& model, double step, const SimulationOptions& options,
+                                       const EffectsEngineOptions& engine) {
+  return simulate_effects(model, effects_step_start(model.parameters(), model.effects(), step), options, engine);
+}
+
+}  // namespace backlash::numeric

@@ -1,0 +1,33 @@
+// numeric/hybrid/gap_events.hpp (internal) — the first gap event of a free flight,
+// shared by the dividing-line tracer and the hybrid simulator.
+#pragma once
+
+#include "backlash/numeric/first_crossing.hpp"
+#include "backlash/numeric/segment_dynamics.hpp"
+
+#include <functional>
+#include <optional>
+
+namespace backlash::numeric::detail {
+
+enum class GapEventKind { OppositeFace, FaceLeft };
+
+struct GapEvent {
+  GapEventKind kind;
+  Crossing crossing;
+  double departure = 0;  ///< FaceLeft: the certified departure t0, w ≠ 0 on (0, t0], the search's start
+};
+
+/// The witness of the gap change Δx = θL − θm − Δx(0) − level of a free flight.
+LinearWitness gap_change_witness(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
+                                 std::function<double(double)> gap_change, double level, double time_unit = 1);
+
+/// A free flight whose gap change Δx(t) = x(t) − x(0) starts at 0 with zero
+/// relative velocity.  `state` gives x(t) = (θm, θ̇m, θL, θ̇L) (any frame),
+/// `gap_change` gives Δx(t) directly.  The first time Δx reaches
+/// `opposite_face_change` (±b) or returns to 0 (certified departure first).
+std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
+                                        std::function<double(double)> gap_change, double opposite_face_change,
+                                        double horizon, double position_scale, double time_unit = 1);
+
+}  // namespace backlash::numeric::detail

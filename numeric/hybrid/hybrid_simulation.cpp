@@ -1,0 +1,550 @@
+#include "backlash/numeric/hybrid_simulation.hpp"
+
+#include "backlash/numeric/first_crossing.hpp"
+#include "hybrid/linear_flight.hpp"
+#include "backlash/numeric/scales.hpp"
+#include "backlash/numeric/segment_dynamics.hpp"
+#include "hybrid/gap_events.hpp"
+#include "hybrid/rest_search.hpp"
+
+#include <boost/math/tools/roots.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <cmath>
+#include <deque>
+#include <functional>
+#include <limits>
+
+namespace backlash::numeric {
+
+const char* to_string(EventKind kind) {
+  switch (kind) {
+    case EventKind::Separation: return "separation";
+    case EventKind::Recombination: return "recombination";
+    case EventKind::Recontact: return "recontact";
+    case EventKind::Rest: return "rest";
+    case EventKind::Stick: return "stick";
+    case EventKind::Slip: return "slip";
+    case EventKind::Saturation: return "saturation";
+    case EventKind::Desaturation: return "desaturation";
+  }
+  return "?";
+}
+
+const char* to_string(Body body) {
+  switch (body) {
+    case Body::None: return "none";
+    case Body::Motor: return "motor";
+    case Body::Load: return "load";
+    case Body::Both: return "both";
+  }
+  return "?";
+}
+
+const char* to_string(SimulationStatus status) {
+  switch (status) {
+    case SimulationStatus::Completed: return "completed";
+    case SimulationStatus::Rest: return "rest";
+    case SimulationStatus::Chattering: return "chattering";
+    case SimulationStatus::EventLimit: return "event_limit";
+    case SimulationStatus::NonFinite: return "non_finite";
+    case SimulationStatus::Unresolved: return "unresolved";
+    case SimulationStatus::WorkLimit: return "work_limit";
+  }
+  return "?";
+}
+
+bool stopped_early(SimulationStatus status) {
+  return status != SimulationStatus::Completed && status != SimulationStatus::Rest;
+}
+
+double zeno_window(const Parameters& p, const SimulationOptions& options) {
+  if (options.zeno_window > 0) return options.zeno_window;
+  return zeno_time_scales / fastest_mode_rate(p);
+}
+
+std::string zeno_reason(const SimulationOptions& options, double window) {
+  char text[96];
+  std::snprintf(text, sizeof text, "%d impacts within %.3g s (Zeno)", options.zeno_impacts, window);
+  return text;
+}
+
+double measured(const Parameters& p, const HybridState& s) {
+  return p.measured_at == model::MeasuredAt::Motor ? s.theta_m : s.theta_L;
+}
+
+double measured_velocity(const Parameters& p, const HybridState& s) {
+  return p.measured_at == model::MeasuredAt::Motor ? s.dtheta_m : s.dtheta_L;
+}
+
+void include_extremes(const Parameters& p, const HybridState& h, Extremes& x) {
+  const double o = measured(p, h);
+  x.theta_o_min = std::min(x.theta_o_min, o);
+  x.theta_o_max = std::max(x.theta_o_max, o);
+  x.theta_m_min = std::min(x.theta_m_min, h.theta_m);
+  x.theta_m_max = std::max(x.theta_m_max, h.theta_m);
+  x.theta_L_min = std::min(x.theta_L_min, h.theta_L);
+  x.theta_L_max = std::max(x.theta_L_max, h.theta_L);
+}
+
+namespace {
+
+HybridState contact_state_on_face(const Parameters& p, int face, double theta_o, double velocity) {
+  return state_on_face(p, face, theta_o, velocity, true);
+}
+
+bool finite(const HybridState& s) {
+  return std::isfinite(s.theta_m) && std::isfinite(s.theta_L) && std::isfinite(s.dtheta_m) && std::isfinite(s.dtheta_L);
+}
+
+// A free flight in the simulation frame: state(τ) and the gap change since its start.
+struct Flight {
+  std::function<HybridState(double)> at;
+  std::function<SmallVector(double)> vector;
+  std::function<double(double)> gap_change;
+};
+
+Flight flight_from_separation_line(const ValidatedEvaluator& evaluator, const HybridState& start) {
+  const Parameters& p = evaluator.parameters();
+  const double v = start.dtheta_m;
+  const double theta0 = evaluator.evaluator().separation_theta(v);  // thesis frame: θm(0) = θL(0) = θ0
+  const double offset_m = start.theta_m - theta0, offset_L = start.theta_L - theta0;
+  (void)p;
+  Flight f;
+  f.at = [&evaluator, v, offset_m, offset_L, face = start.face](double tau) {
+    const FreeState s = evaluator.free_state(tau, v);
+    HybridState h;
+    h.in_contact = false;
+    h.face = face;
+    h.theta_m = s.theta_m + offset_m;
+    h.theta_L = s.theta_L + offset_L;
+    h.dtheta_m = s.dtheta_m;
+    h.dtheta_L = s.dtheta_L;
+    return h;
+  };
+  f.vector = [at = f.at](double tau) {
+    const HybridState h = at(tau);
+    SmallVector x(4);
+    x << h.theta_m, h.dtheta_m, h.theta_L, h.dtheta_L;
+    return x;
+  };
+  f.gap_change = [&evaluator, v](double tau) { return evaluator.free_state(tau, v).gap; };
+  return f;
+}
+
+Flight flight_from_state(const Parameters& p, const HybridState& start) {
+  SmallVector x0(4);
+  x0 << start.theta_m, start.dtheta_m, start.theta_L, start.dtheta_L;
+  auto flight = std::make_shared<LinearFlight>(free_mode_segment(p), x0);
+  Flight f;
+  f.vector = [flight](double tau) { return flight->state(tau); };
+  f.at = [flight, face = start.face](double tau) {
+    const SmallVector x = flight->state(tau);
+    HybridState h;
+    h.in_contact = false;
+    h.face = face;
+    h.theta_m = x(0);
+    h.dtheta_m = x(1);
+    h.theta_L = x(2);
+    h.dtheta_L = x(3);
+    return h;
+  };
+  f.gap_change = [flight](double tau) {
+    const SmallVector dx = flight->change(tau);
+    return dx(2) - dx(0);
+  };
+  return f;
+}
+
+// A velocity as the angle it sweeps in the servo's time unit √(J/K) (1 s for the thesis's cases):
+// the scale of a state's angles for rounding tolerances, whatever the gain.
+double swept_angle(const Parameters& p, double velocity) { return velocity * servo_time_unit(p); }
+
+bool on_separation_line(const ValidatedEvaluator& evaluator, double theta_o, double velocity) {
+  const double line = evaluator.evaluator().separation_theta(velocity);
+  const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(evaluator.parameters(), velocity))});
+  return std::fabs(theta_o - line) <= 1e-9 * scale;
+}
+
+// Extremes of a segment on [0, duration]: its end states and the certified zeros of θ̇m and θ̇L
+// (in contact both are θ̇o).  `vector(τ)` is the segment's state x, x' = A x + c.
+void segment_extremes(const Parameters& p, const LinearSegment& segment, const std::function<SmallVector(double)>& vector,
+                      const std::function<HybridState(double)>& at, double duration, bool contact, Extremes& x) {
+  include_extremes(p, at(0), x);
+  include_extremes(p, at(duration), x);
+  const Eigen::Index n = segment.A.rows();
+  std::vector<Eigen::Index> velocity_rows = contact ? std::vector<Eigen::Index>{1} : std::vector<Eigen::Index>{1, 3};
+  for (Eigen::Index row : velocity_rows) {
+    LinearWitness w;
+    w.A = segment.A;
+    w.c = segment.c;
+    w.e = SmallRow::Zero(n);
+    w.e(row) = 1;
+    w.state = vector;
+    w.time_unit = servo_time_unit(p);
+    double from = 0;
+    for (int k = 0; k < 10000; ++k) {
+      const auto zero = first_crossing(w, from, duration);
+      if (!zero) break;
+      include_extremes(p, at(zero->t), x);
+      from = zero->t + 1e-12 * std::max(w.time_unit, zero->t);
+      if (from >= duration) break;
+    }
+  }
+}
+
+
+}  // namespace
+
+HybridState state_on_face(const Parameters& p, int face, double theta_o, double velocity, bool in_contact) {
+  HybridState s;
+  s.in_contact = in_contact;
+  s.face = face;
+  s.dtheta_m = s.dtheta_L = velocity;
+  const double x = face * p.backlash / 2;  // θL − θm
+  if (p.measured_at == model::MeasuredAt::Motor) {
+    s.theta_m = theta_o;
+    s.theta_L = theta_o + x;
+  } else {
+    s.theta_L = theta_o;
+    s.theta_m = theta_o - x;
+  }
+  return s;
+}
+
+HybridState step_start(const Parameters& p, double step) {
+  // θo = θR − A, at rest, on the face that drives toward θR: for A > 0 the motor pushes
+  // forward (x = −b/2), for A < 0 backward (x = +b/2).
+  return contact_state_on_face(p, step >= 0 ? -1 : +1, p.theta_R - step, 0);
+}
+
+HybridState rigid_start(const Parameters& p, const HybridState& start) {
+  if (p.backlash > 0) return start;
+  const double omega = start.dtheta_m == start.dtheta_L ? start.dtheta_m
+                                                        : recombined_velocity(p, start.dtheta_m, start.dtheta_L);
+  const int face = start.face == 0 ? -1 : start.face;
+  return contact_state_on_face(p, face, measured(p, start), omega);
+}
+
+namespace {
+
+// One run of the closed-form hybrid automaton from a start state: contact segments (the
+// validated closed form, separation at the first certified zero of Tc) and free flights (the
+// first certified gap event), joined by the impact law.
+class ClosedFormRun {
+ public:
+  ClosedFormRun(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options)
+      : evaluator_(evaluator),
+        p_(evaluator.parameters()),
+        o_(options),
+        recorder_(p_, options, result_),
+        contact_segment_(contact_mode_segment(p_)),
+        free_segment_(free_mode_segment(p_)),
+        torque_(transmitted_torque(p_)),
+        rigid_(p_.backlash <= 0),  // a rigid drive: contact for ever, no events
+        state_(rigid_ ? rigid_start(p_, start) : start) {}
+
+  SimulationResult run() {
+    try {
+      while (t_ < o_.t_end) {
+        if (!finite(state_)) return stop(SimulationStatus::NonFinite, "the state is no longer finite");
+        if (events_ >= o_.max_events)
+          return stop(SimulationStatus::EventLimit,
+                      "the event cap of " + std::to_string(o_.max_events) + " events was reached");
+        if (auto problem = resolution_problem(p_, motion_scale(p_, state_.theta_m, state_.theta_L), "the motion"))
+          return stop(SimulationStatus::Unresolved, *problem);
+        const std::optional<SimulationStatus> end = state_.in_contact ? contact() : flight();
+        if (end) return finish(*end);
+      }
+    } catch (const SearchBudgetExhausted& budget) {
+      return stop(SimulationStatus::WorkLimit, budget.what());
+    }
+    return finish(SimulationStatus::Completed);
+  }
+
+ private:
+  SimulationResult finish(SimulationStatus status) {
+    result_.status = status;
+    result_.t_final = t_;
+    result_.final_state = state_;
+    result_.theta_o_final = measured(p_, state_);
+    return result_;
+  }
+  SimulationResult stop(SimulationStatus status, std::string reason) {
+    result_.stop_reason = std::move(reason);
+    return finish(status);
+  }
+  void push_event(EventKind kind, bool bounce, bool grazing) {
+    SimulationEvent e;
+    e.t = t_;
+    e.kind = kind;
+    e.theta_o = measured(p_, state_);
+    e.dtheta_o = measured_velocity(p_, state_);
+    e.after = state_;
+    e.bounce = bounce;
+    e.grazing = grazing;
+    ++events_;
+    if (o_.event_sink) o_.event_sink(e);
+    else result_.events.push_back(e);
+  }
+
+  std::optional<SimulationStatus> contact();
+  LinearWitness contact_torque_witness(double theta0, double omega0) const;
+  std::optional<Crossing> separation(const LinearWitness& w, double theta0, double omega0, double remaining) const;
+  std::optional<SimulationStatus> flight();
+  SimulationStatus rest(const Flight& flight, double remaining, const HybridState& end);
+  std::optional<SimulationStatus> impact(const detail::GapEvent& event, const HybridState& before);
+  std::optional<std::string> unresolved_return(const detail::GapEvent& event) const;
+
+  const ValidatedEvaluator& evaluator_;
+  const Parameters& p_;
+  const SimulationOptions& o_;
+  SimulationResult result_;
+  TrajectoryRecorder recorder_;
+  const LinearSegment contact_segment_, free_segment_;
+  const TransmittedTorque torque_;
+  const bool rigid_;
+  HybridState state_;
+  double t_ = 0;
+  std::deque<double> impacts_;
+  long separations_ = 0;
+  long events_ = 0;  // events so far (kept or sunk)
+};
+
+// Tc = JL θ̈o + FL θ̇o along the contact segment from (θ0, ω0), as a certified witness.
+LinearWitness ClosedFormRun::contact_torque_witness(double theta0, double omega0) const {
+  LinearWitness w;
+  w.A = contact_segment_.A;
+  w.c = contact_segment_.c;
+  w.e = torque_.r;
+  w.level = 0;  // w = Tc, given directly by `value` below (eᵀx' and its bounds need no level)
+  w.time_unit = servo_time_unit(p_);
+  const ValidatedEvaluator& evaluator = evaluator_;
+  w.state = [&evaluator, theta0, omega0](double tau) {
+    const ContactState c = evaluator.contact_state(tau, theta0, omega0);
+    SmallVector y(2);
+    y << c.theta_o, c.dtheta_o;
+    return y;
+  };
+  // Tc = (JL K/J)(θR − θo) + (FL − JL F/J) θ̇o without the cancellation θR − θo: by
+  // linearity θo − θR = (θo0 − θR)·a(τ) + θ̇o0·b(τ) with the unit responses a, b of the
+  // validated closed form, so the rounding error scales with the motion, not with θR.
+  // Far from a zero of Tc the cancellation is harmless, so the unit responses are only
+  // evaluated where |Tc| is within a few thousand ulps of θR's scale.
+  const double cancellation_scale = 4096 * std::numeric_limits<double>::epsilon() * std::fabs(torque_.r(0)) *
+                                    std::max(1.0, std::fabs(p_.theta_R));
+  w.value = [&evaluator, &p = p_, &torque = torque_, theta0, omega0, cancellation_scale](double tau) {
+    const ContactState c = evaluator.contact_state(tau, theta0, omega0);
+    const double direct = torque.r(0) * (c.theta_o - p.theta_R) + torque.r(1) * c.dtheta_o;
+    if (std::fabs(direct) > cancellation_scale) return direct;
+    const double a = evaluator.contact_state(tau, p.theta_R + 1, 0).theta_o - p.theta_R;
+    const double b = evaluator.contact_state(tau, p.theta_R, 1).theta_o - p.theta_R;
+    const double deviation = (theta0 - p.theta_R) * a + omega0 * b;
+    return torque.r(0) * deviation + torque.r(1) * c.dtheta_o;
+  };
+  return w;
+}
+
+// The next time Tc leaves its holding sign within `remaining` (a grazing touch keeps contact).
+std::optional<Crossing> ClosedFormRun::separation(const LinearWitness& w, double theta0, double omega0,
+                                                  double remaining) const {
+  std::optional<Crossing> separation;
+  double from = 0;
+  if (std::fabs(transmitted_torque_at(p_, theta0, omega0)) <= 1e-13 * std::max(1.0, std::fabs(omega0))) {
+    // Starting on the separation line: certified departure of Tc first.
+    if (auto t0 = certified_departure(w, 1e-12)) from = *t0;
+  }
+  while (!rigid_) {
+    separation = first_crossing(w, from, remaining);
+    if (!separation || !separation->grazing) break;
+    from = separation->t + 1e-12 * std::max(w.time_unit, separation->t);
+  }
+  // Tc = r·y + r0 goes through the cancellation θR − θo: once the contact motion has decayed
+  // to rounding level its sign is noise, and a "separation" found there is spurious (e.g. an
+  // over-damped contact whose Tc = A e^{λ1 t} + B e^{λ2 t} has no zero for t > 0).  The test is
+  // on the state, not on Tc's terms: when Fm/Jm = FL/JL the velocity term of Tc vanishes
+  // identically and every genuine separation happens at θo = θR, with θ̇o far from zero.
+  if (separation) {
+    const ContactState c = evaluator_.contact_state(separation->t, theta0, omega0);
+    const double noise = 1024 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(p_.theta_R));
+    const double rate = std::sqrt(p_.K / (p_.Jm + p_.JL));  // converts a velocity to a displacement scale
+    if (std::fabs(c.theta_o - p_.theta_R) <= noise && std::fabs(c.dtheta_o) <= noise * rate) separation.reset();
+  }
+  return separation;
+}
+
+// A contact segment on the face σ held: to the separation, or to t_end.
+std::optional<SimulationStatus> ClosedFormRun::contact() {
+  const double remaining = o_.t_end - t_;
+  const double theta0 = measured(p_, state_), omega0 = state_.dtheta_m;
+  const LinearWitness w = contact_torque_witness(theta0, omega0);
+  const int face = state_.face;
+  auto at = [&evaluator = evaluator_, &p = p_, theta0, omega0, face](double tau) {
+    const ContactState c = evaluator.contact_state(tau, theta0, omega0);
+    return contact_state_on_face(p, face, c.theta_o, c.dtheta_o);
+  };
+  const std::optional<Crossing> separated = separation(w, theta0, omega0, remaining);
+  if (o_.track_extremes)
+    segment_extremes(p_, contact_segment_, w.state, at, separated ? separated->t : remaining, true, result_.extremes);
+  if (!separated) {
+    recorder_.record(t_, o_.t_end + 1e-12, at);
+    state_ = at(remaining);
+    t_ = o_.t_end;
+    return SimulationStatus::Completed;
+  }
+  recorder_.record(t_, t_ + separated->t + 1e-12, at);
+  const HybridState at_separation = at(separated->t);
+  t_ += separated->t;
+  state_ = at_separation;
+  state_.in_contact = false;  // face σ is the face just left
+  push_event(EventKind::Separation, false, false);
+  if (o_.stop_after_separations > 0 && ++separations_ >= o_.stop_after_separations) return SimulationStatus::Completed;
+  return std::nullopt;
+}
+
+// A free flight: to the first gap event (an impact), or to t_end (at rest, or still moving).
+std::optional<SimulationStatus> ClosedFormRun::flight() {
+  const double remaining = o_.t_end - t_;
+  const double theta_o = measured(p_, state_);
+  const bool from_line = std::fabs(state_.dtheta_m - state_.dtheta_L) <= 1e-12 * std::max(1.0, std::fabs(state_.dtheta_m)) &&
+                         on_separation_line(evaluator_, theta_o, state_.dtheta_m);
+  const Flight flight = from_line ? flight_from_separation_line(evaluator_, state_) : flight_from_state(p_, state_);
+  const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(p_, state_.dtheta_m))});
+  const auto event =
+      detail::first_gap_event(free_segment_, flight.vector, flight.gap_change, -state_.face * p_.backlash, remaining, scale,
+                              servo_time_unit(p_));
+  if (o_.track_extremes)
+    segment_extremes(p_, free_segment_, flight.vector, flight.at, event ? event->crossing.t : remaining, false,
+                     result_.extremes);
+  if (!event) {
+    recorder_.record(t_, o_.t_end + 1e-12, flight.at);
+    const HybridState end = flight.at(remaining);
+    const double speed = std::max(std::fabs(end.dtheta_m), std::fabs(end.dtheta_L));
+    if (speed < o_.rest_velocity) return rest(flight, remaining, end);
+    state_ = end;
+    t_ = o_.t_end;
+    return SimulationStatus::Completed;
+  }
+  if (auto problem = unresolved_return(*event)) {
+    result_.stop_reason = std::move(*problem);
+    return SimulationStatus::Unresolved;
+  }
+  recorder_.record(t_, t_ + event->crossing.t + 1e-12, flight.at);
+  const HybridState before = flight.at(event->crossing.t);
+  t_ += event->crossing.t;
+  return impact(*event, before);
+}
+
+// A return to the face just left, found within the search's resolution of the certified
+// departure t0 (w ≠ 0 on (0, t0]): the exact flight departs as t² or t³ and cannot return there,
+// so the search has not resolved the gap from rounding (a flight of no length, which would
+// start a burst of events at one instant).  Said, never continued (docs/physics.md, leaving a face).
+std::optional<std::string> ClosedFormRun::unresolved_return(const detail::GapEvent& event) const {
+  if (event.kind != detail::GapEventKind::FaceLeft) return std::nullopt;
+  const double resolution = CrossingOptions{}.min_interval * servo_time_unit(p_);
+  if (event.crossing.t > event.departure + resolution) return std::nullopt;
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "the free flight from t = %.17g s returned to the face it left after %.3g s, within the "
+                "search's resolution %.3g s of its certified departure: the gap is not resolved from rounding",
+                t_, event.crossing.t, resolution);
+  return std::string(text);
+}
+
+// Rest: the event at the last time any velocity exceeded the tolerance (bisection on the
+// closed form), then the state at t_end.
+SimulationStatus ClosedFormRun::rest(const Flight& flight, double remaining, const HybridState& end) {
+  const double hi = detail::rest_time([&](double t) { return flight.at(t); }, remaining, o_.rest_velocity);
+  const double t_end = t_ + remaining;
+  t_ += hi;
+  state_ = flight.at(hi);
+  push_event(EventKind::Rest, false, false);
+  t_ = t_end;
+  state_ = end;
+  return SimulationStatus::Rest;
+}
+
+// Inelastic impact (eq. 24) on the face hit; contact holds if the torque has its holding sign
+// there, else the bodies part again at once (a bounce).  Chattering when impacts come denser
+// than zeno_impacts in the Zeno window.
+std::optional<SimulationStatus> ClosedFormRun::impact(const detail::GapEvent& event, const HybridState& before) {
+  const bool opposite = event.kind == detail::GapEventKind::OppositeFace;
+  const int face_hit = opposite ? -state_.face : state_.face;
+  const double omega = recombined_velocity(p_, before.dtheta_m, before.dtheta_L);
+  state_ = contact_state_on_face(p_, face_hit, measured(p_, before), omega);
+  const double tc = transmitted_torque_at(p_, measured(p_, state_), omega);
+  const bool holds = -face_hit * tc >= -1e-14 * std::max(1.0, std::fabs(tc));
+  if (!holds) state_.in_contact = false;  // a bounce: the bodies part again at once
+  push_event(opposite ? EventKind::Recombination : EventKind::Recontact, !holds, event.crossing.grazing);
+  impacts_.push_back(t_);
+  const double window = zeno_window(p_, o_);
+  while (!impacts_.empty() && impacts_.front() < t_ - window) impacts_.pop_front();
+  if (static_cast<int>(impacts_.size()) >= o_.zeno_impacts) {
+    result_.stop_reason = zeno_reason(o_, window);
+    return SimulationStatus::Chattering;
+  }
+  return std::nullopt;
+}
+
+SimulationResult simulate_as_given(const ValidatedEvaluator& evaluator, const HybridState& start,
+                                   const SimulationOptions& options) {
+  return ClosedFormRun(evaluator, start, options).run();
+}
+
+void shift_state(HybridState& s, double offset) {
+  s.theta_m += offset;
+  s.theta_L += offset;
+}
+
+}  // namespace
+
+// The numerics run in error coordinates (validation.hpp, in_error_coordinates): the angles are
+// shifted by −θR on the way in and by +θR on the way out, so the gap θL − θm keeps its digits
+// whatever θR is.  A generated case evaluator (θR folded in) runs as given.
+SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options) {
+  const std::optional<ValidatedEvaluator> centred = in_error_coordinates(evaluator);
+  if (!centred) return simulate_as_given(evaluator, start, options);
+  const double R = evaluator.parameters().theta_R;
+  HybridState from = start;
+  shift_state(from, -R);
+  SimulationOptions shifted = options;
+  auto shift_sample = [R](TrajectorySample& s) {
+    s.theta_o += R;
+    s.theta_m += R;
+    s.theta_L += R;
+  };
+  if (options.event_sink)
+    shifted.event_sink = [&options, R](const SimulationEvent& event) {
+      SimulationEvent moved = event;
+      moved.theta_o += R;
+      shift_state(moved.after, R);
+      shift_state(moved.before, R);
+      options.event_sink(moved);
+    };
+  if (options.sample_sink)
+    shifted.sample_sink = [&options, &shift_sample](const TrajectorySample& sample) {
+      TrajectorySample moved = sample;
+      shift_sample(moved);
+      options.sample_sink(moved);
+    };
+  SimulationResult r = simulate_as_given(*centred, from, shifted);
+  for (SimulationEvent& e : r.events) {
+    e.theta_o += R;
+    shift_state(e.after, R);
+    shift_state(e.before, R);
+  }
+  shift_state(r.final_state, R);
+  r.theta_o_final += R;
+  for (TrajectorySample& s : r.samples) shift_sample(s);
+  for (double* angle : {&r.extremes.theta_o_min, &r.extremes.theta_o_max, &r.extremes.theta_m_min, &r.extremes.theta_m_max,
+                        &r.extremes.theta_L_min, &r.extremes.theta_L_max})
+    *angle += R;  // ±infinity (nothing tracked) stays
+  return r;
+}
+
+SimulationResult simulate_step(const ValidatedEvaluator& evaluator, double step, const SimulationOptions& options) {
+  return simulate(evaluator, step_start(evaluator.parameters(), step), options);
+}
+
+}  // namespace backlash::numeric
