@@ -4,13 +4,14 @@
 #pragma once
 
 #include "backlash/model/case_spec.hpp"
+#include "backlash/output/text.hpp"
 
 #include <string>
 
 namespace backlash::discrepancy::detail {
 
 std::string decimal(double value);
-std::string quoted(const std::string& text);
+using output::toml_string;  // a TOML basic string (backlash/output/text.hpp)
 std::string exact_or(const model::Rational& original, double value);
 
 }  // namespace backlash::discrepancy::detail
