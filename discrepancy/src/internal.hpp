@@ -101,10 +101,4 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
                   bool whole_record, const std::vector<double>* start_u = nullptr, long budget = std::numeric_limits<long>::max(),
                   double departure = NAN);
 
-/// Case-file text (case_file.cpp): the shortest decimal that reads back as the same double,
-/// a TOML basic string, and the original exact value when the fit kept it (else the decimal).
-std::string decimal(double value);
-std::string quoted(const std::string& text);
-std::string exact_or(const model::Rational& original, double value);
-
 }  // namespace backlash::discrepancy::detail
