@@ -9,12 +9,14 @@
 
 #include "backlash/measurements/measured_record.hpp"
 #include "backlash/output/text.hpp"
+#include "backlash/model/case_writer.hpp"
 
 #include <algorithm>
-#include <array>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <tuple>
+#include <vector>
 
 namespace backlash::api {
 
@@ -28,49 +30,75 @@ std::string one_line(std::string text) {
   return text;
 }
 
-std::string exact(const model::Rational& value) { return toml_string(model::to_string(value)); }
 
-/// The facade's parameter names and the case file's keys they stand for.
+/// The facade's parameter names and the case file's keys they stand for: the structure and
+/// the experiment here, then every effect parameter of the table of effects by its NAME.
 struct ParameterKey {
-  const char* name;
-  const char* key;
+  std::string name;
+  std::string key;
 };
-constexpr std::array<ParameterKey, 21> parameter_keys{{
-    {"name", "name"},
-    {"measured_at", "measured_at"},
-    {"K", "K"},
-    {"backlash", "backlash"},
-    {"reference", "reference"},
-    {"Jm", "motor.J"},
-    {"Fm", "motor.F"},
-    {"JL", "load.J"},
-    {"FL", "load.F"},
-    {"experiment", "experiment.kind"},
-    {"step", "experiment.step"},
-    {"t_end", "experiment.t_end"},
-    {"drive_gain", "experiment.drive_gain"},
-    {"coulomb_motor", "effects.coulomb_motor"},
-    {"coulomb_load", "effects.coulomb_load"},
-    {"restitution", "effects.restitution"},
-    {"saturation", "effects.saturation"},
-    {"stiffness", "effects.compliance.stiffness"},
-    {"damping", "effects.compliance.damping"},
-    {"delay", "effects.delay"},
-    {"torque_offset", "effects.torque_offset"},
-}};
+
+const std::vector<ParameterKey>& parameter_keys() {
+  static const std::vector<ParameterKey> keys = [] {
+    std::vector<ParameterKey> k{{"name", "name"},
+                                {"measured_at", "measured_at"},
+                                {"K", "K"},
+                                {"backlash", "backlash"},
+                                {"reference", "reference"},
+                                {"Jm", "motor.J"},
+                                {"Fm", "motor.F"},
+                                {"JL", "load.J"},
+                                {"FL", "load.F"},
+                                {"experiment", "experiment.kind"},
+                                {"step", "experiment.step"},
+                                {"t_end", "experiment.t_end"},
+                                {"drive_gain", "experiment.drive_gain"}};
+    for (const model::EffectParameterInfo& p : model::effect_parameters) {
+      const std::string effect(p.effect), key(p.key);
+      k.push_back({std::string(p.name), "effects." + (key == effect ? key : effect + "." + key)});
+    }
+    return k;
+  }();
+  return keys;
+}
 
 std::string allowed_names() {
   std::string names;
-  for (const ParameterKey& k : parameter_keys) names += (names.empty() ? "" : " ") + std::string(k.name);
+  for (const ParameterKey& k : parameter_keys()) names += (names.empty() ? "" : " ") + k.name;
   return names;
 }
 
-/// The facade's name of a case-file key ("motor.J" → "Jm"); the key itself when it has none.
+/// The facade's name of a case-file key ("motor.J" → "Jm"); the key itself when it has none
+/// (an effect of several parameters is named by its first).
 std::string name_of_key(const std::string& key) {
-  for (const ParameterKey& k : parameter_keys)
+  for (const ParameterKey& k : parameter_keys())
     if (key == k.key) return k.name;
-  if (key == "effects.compliance") return "stiffness";
+  for (const model::EffectInfo& effect : model::effects_table)
+    if (key == "effects." + std::string(effect.key)) return std::string(effect.primary().name);
   return key;
+}
+
+/// The [effects] table of the facade's texts, `NAME = "value"` (an effect of several
+/// parameters as `KEY = { ... }` with those given).
+std::string effects_text(const std::function<const std::string*(const std::string&)>& value) {
+  std::ostringstream effects;
+  for (const bool single : {true, false})
+    for (const model::EffectInfo& effect : model::effects_table) {
+      if (effect.single() != single) continue;
+      std::ostringstream entries;
+      const char* separator = " ";
+      for (std::size_t i = effect.first; i < effect.first + effect.count; ++i)
+        if (const std::string* v = value(std::string(model::effect_parameters[i].name))) {
+          entries << separator << model::effect_parameters[i].key << " = " << toml_string(*v);
+          separator = ", ";
+        }
+      if (entries.str().empty()) continue;
+      if (single)
+        effects << entries.str().substr(1) << "\n";  // "KEY = value"
+      else
+        effects << effect.key << " = {" << entries.str() << " }\n";
+    }
+  return effects.str();
 }
 
 /// Reads `text` as a case file named `pseudo_file`; a problem becomes a BadInput naming
@@ -115,12 +143,12 @@ Case Case::from_text(const std::string& toml, const std::string& name, const std
 Case Case::from_texts(const std::vector<std::pair<std::string, std::string>>& parameters) {
   std::map<std::string, std::string> given;  // facade name → value text
   for (const auto& [name, value] : parameters) {
-    const bool known = std::any_of(parameter_keys.begin(), parameter_keys.end(),
+    const bool known = std::any_of(parameter_keys().begin(), parameter_keys().end(),
                                    [&](const ParameterKey& k) { return name == k.name; });
     if (!known) throw BadInput(name, "unknown parameter (allowed: " + allowed_names() + ")");
     if (!given.emplace(name, value).second) throw BadInput(name, "given twice");
   }
-  auto value = [&](const char* name) -> const std::string* {
+  auto value = [&](const std::string& name) -> const std::string* {
     const auto found = given.find(name);
     return found == given.end() ? nullptr : &found->second;
   };
@@ -144,21 +172,8 @@ Case Case::from_texts(const std::vector<std::pair<std::string, std::string>>& pa
     for (const char* key : {"step", "t_end", "drive_gain"})
       if (const std::string* v = value(key)) toml << key << " = " << toml_string(*v) << "\n";
   }
-  const bool compliance = value("stiffness") || value("damping");
-  std::ostringstream effects;
-  for (const char* key : {"coulomb_motor", "coulomb_load", "restitution", "saturation", "delay", "torque_offset"})
-    if (const std::string* v = value(key)) effects << key << " = " << toml_string(*v) << "\n";
-  if (compliance) {
-    effects << "compliance = {";
-    const char* separator = " ";
-    for (const char* key : {"stiffness", "damping"})
-      if (const std::string* v = value(key)) {
-        effects << separator << key << " = " << toml_string(*v);
-        separator = ", ";
-      }
-    effects << " }\n";
-  }
-  if (!effects.str().empty()) toml << "[effects]\n" << effects.str();
+  const std::string effects = effects_text(value);
+  if (!effects.empty()) toml << "[effects]\n" << effects;
 
   model::CaseSpec spec = read_parameters_text(toml.str(), "<parameters>");
   spec.id = name;
@@ -182,60 +197,16 @@ Case Case::from_parameters(const CaseParameters& p) {
   if (p.step) texts.emplace_back("step", model::to_string(*p.step));
   if (p.t_end) texts.emplace_back("t_end", model::to_string(*p.t_end));
   if (p.t_end && !p.step) throw BadInput("t_end", "an end time needs a step experiment (give step too)");
-  const model::Effects& e = p.effects;
-  if (e.coulomb_motor != 0) texts.emplace_back("coulomb_motor", model::to_string(e.coulomb_motor));
-  if (e.coulomb_load != 0) texts.emplace_back("coulomb_load", model::to_string(e.coulomb_load));
-  if (e.restitution != 0) texts.emplace_back("restitution", model::to_string(e.restitution));
-  if (e.saturation) texts.emplace_back("saturation", model::to_string(*e.saturation));
-  if (e.compliance) {
-    texts.emplace_back("stiffness", model::to_string(e.compliance->stiffness));
-    texts.emplace_back("damping", model::to_string(e.compliance->damping));
+  for (const model::EffectInfo& effect : model::effects_table) {
+    if (!p.effects.has(effect)) continue;
+    for (std::size_t i = effect.first; i < effect.first + effect.count; ++i)
+      if (const auto& v = model::field(p.effects, model::effect_parameters[i].id))
+        texts.emplace_back(std::string(model::effect_parameters[i].name), model::to_string(*v));
   }
-  if (e.delay != 0) texts.emplace_back("delay", model::to_string(e.delay));
-  if (e.torque_offset != 0) texts.emplace_back("torque_offset", model::to_string(e.torque_offset));
   return from_texts(texts);
 }
 
-std::string Case::case_file() const {
-  const model::CaseSpec& s = spec_;
-  std::ostringstream out;
-  out << "name = " << toml_string(s.name) << "\n";
-  out << "measured_at = \"" << model::to_string(s.measured_at) << "\"\n";
-  out << "K = " << exact(s.K) << "\n";
-  out << "backlash = " << exact(s.backlash) << "\n";
-  out << "reference = " << exact(s.reference) << "\n";
-  out << "[motor]\nJ = " << exact(s.Jm) << "\nF = " << exact(s.Fm) << "\n";
-  out << "[load]\nJ = " << exact(s.JL) << "\nF = " << exact(s.FL) << "\n";
-  if (s.experiment) {
-    const model::Experiment& x = *s.experiment;
-    out << "[experiment]\n";
-    if (x.kind == model::ExperimentKind::Step) {
-      out << "step = " << exact(x.step) << "\n";
-    } else {
-      out << "kind = \"drive\"\ndrive_gain = " << exact(x.drive_gain) << "\n";
-    }
-    if (x.t_end) out << "t_end = " << exact(*x.t_end) << "\n";
-  }
-  if (s.effects.any()) {
-    const model::Effects& e = s.effects;
-    out << "[effects]\n";
-    if (e.coulomb_motor != 0) out << "coulomb_motor = " << exact(e.coulomb_motor) << "\n";
-    if (e.coulomb_load != 0) out << "coulomb_load = " << exact(e.coulomb_load) << "\n";
-    if (e.restitution != 0) out << "restitution = " << exact(e.restitution) << "\n";
-    if (e.saturation) out << "saturation = " << exact(*e.saturation) << "\n";
-    if (e.compliance)
-      out << "compliance = { stiffness = " << exact(e.compliance->stiffness) << ", damping = " << exact(e.compliance->damping)
-          << " }\n";
-    if (e.delay != 0) out << "delay = " << exact(e.delay) << "\n";
-    if (e.torque_offset != 0) out << "torque_offset = " << exact(e.torque_offset) << "\n";
-  }
-  if (!s.fit_free.empty()) {
-    out << "[fit]\nfree = [";
-    for (std::size_t i = 0; i < s.fit_free.size(); ++i) out << (i ? ", " : "") << toml_string(s.fit_free[i]);
-    out << "]\n";
-  }
-  return out.str();
-}
+std::string Case::case_file() const { return model::write_case_file(spec_); }
 
 Case load(const std::string& case_or_path) { return Case::load(case_or_path); }
 Case load(const CaseParameters& parameters) { return Case::from_parameters(parameters); }

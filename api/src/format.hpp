@@ -43,13 +43,16 @@ inline std::string number_text(double value) {
 /// The effects as JSON: {"coulomb_load": 0.03, ...}, only those present.
 inline nlohmann::json effects_json(const numeric::Effects& e) {
   nlohmann::json out = nlohmann::json::object();
-  if (e.coulomb_motor > 0) out["coulomb_motor"] = e.coulomb_motor;
-  if (e.coulomb_load > 0) out["coulomb_load"] = e.coulomb_load;
-  if (e.restitution != 0) out["restitution"] = e.restitution;
-  if (e.saturating()) out["saturation"] = e.saturation;
-  if (e.compliant()) out["compliance"] = {{"stiffness", e.mesh_stiffness}, {"damping", e.mesh_damping}};
-  if (e.delayed()) out["delay"] = e.delay;
-  if (e.torque_offset != 0) out["torque_offset"] = e.torque_offset;
+  for (const model::EffectInfo& effect : model::effects_table) {
+    if (!e.has(effect)) continue;
+    if (effect.single()) {
+      out[std::string(effect.key)] = model::field(e, effect.primary().id);
+      continue;
+    }
+    nlohmann::json& parameters = out[std::string(effect.key)] = nlohmann::json::object();
+    for (std::size_t i = effect.first; i < effect.first + effect.count; ++i)
+      parameters[std::string(model::effect_parameters[i].key)] = model::field(e, model::effect_parameters[i].id);
+  }
   return out;
 }
 

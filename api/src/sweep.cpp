@@ -4,6 +4,8 @@
 
 #include "format.hpp"
 
+#include "backlash/numeric/varied_parameter.hpp"
+
 #include "backlash/symbolic/escape.hpp"
 
 #include <algorithm>
@@ -22,56 +24,14 @@ namespace {
 constexpr long largest_points = (1L << 40) / 3;
 constexpr int largest_threads = 1024;
 
-/// How a varied name sets x in the parameters or effects (`base`: the case's parameters).
-using Setter = void (*)(numeric::Parameters& p, numeric::Effects& e, const numeric::Parameters& base, double x);
-
-struct Varied {
-  std::string_view name;
-  Setter set;
-};
-
-constexpr std::array<Varied, 17> varied{{
-    {"Jm", [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters&, double x) { p.Jm = x; }},
-    {"Fm", [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters&, double x) { p.Fm = x; }},
-    {"JL", [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters&, double x) { p.JL = x; }},
-    {"FL", [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters&, double x) { p.FL = x; }},
-    {"K", [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters&, double x) { p.K = x; }},
-    {"backlash", [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters&, double x) { p.backlash = x; }},
-    {"reference", [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters&, double x) { p.theta_R = x; }},
-    {"JL_over_Jm",  // keeping J = Jm + JL
-     [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters& base, double x) {
-       const double J = base.Jm + base.JL;
-       p.Jm = J / (1 + x);
-       p.JL = J * x / (1 + x);
-     }},
-    {"FL_over_F",  // keeping F = Fm + FL
-     [](numeric::Parameters& p, numeric::Effects&, const numeric::Parameters& base, double x) {
-       const double F = base.Fm + base.FL;
-       p.FL = x * F;
-       p.Fm = F - p.FL;
-     }},
-    {"coulomb_motor", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.coulomb_motor = x; }},
-    {"coulomb_load", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.coulomb_load = x; }},
-    {"restitution", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.restitution = x; }},
-    {"saturation", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.saturation = x; }},
-    {"stiffness", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.mesh_stiffness = x; }},
-    {"damping", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.mesh_damping = x; }},
-    {"delay", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.delay = x; }},
-    {"torque_offset", [](numeric::Parameters&, numeric::Effects& e, const numeric::Parameters&, double x) { e.torque_offset = x; }},
-}};
-
-std::string varied_names() {
-  std::string names;
-  for (const Varied& v : varied) names += (names.empty() ? "" : ", ") + std::string(v.name);
-  return names;
-}
+std::string varied_names() { return numeric::varied_parameter_names(", "); }
 
 /// A case's sweep: its parameters and effects with one of them set to x_i.
 struct CaseSweep {
   std::string series;
   numeric::Parameters base;
   numeric::Effects base_effects;
-  Setter set = nullptr;
+  numeric::VariedParameter varied;
   double from = 0, to = 0;
   long n = 1;
 
@@ -80,7 +40,7 @@ struct CaseSweep {
   }
   numeric::SweepPoint point(long i) const {
     numeric::SweepPoint out{series, x(i), base, base_effects};
-    set(out.parameters, out.effects, base, out.x);
+    numeric::set_varied(varied, out.x, out.parameters, out.effects, base);
     return out;
   }
 };
@@ -92,29 +52,25 @@ void check_ends(const CaseSweep& sweep, const std::string& vary) {
     const numeric::Parameters& p = pt.parameters;
     const numeric::Effects& e = pt.effects;
     const std::string end = i == 0 ? "from" : "to", at = vary + " = " + detail::number_text(pt.x);
-    if (!(p.Jm > 0) || !(p.JL > 0) || p.Fm < 0 || p.FL < 0 || !(p.K > 0) || p.backlash < 0)
-      throw BadInput(end, at + " gives non-physical parameters");
-    if (e.coulomb_motor < 0 || e.coulomb_load < 0 || e.restitution < 0 || e.restitution >= 1 || !(e.saturation > 0) ||
-        !(e.mesh_stiffness > 0) || e.mesh_damping < 0 || e.delay < 0)
-      throw BadInput(end, at + " is outside the effect's range (docs/effects.md)");
+    if (!numeric::physical(p)) throw BadInput(end, at + " gives non-physical parameters");
+    if (!numeric::admissible(e)) throw BadInput(end, at + " is outside the effect's range (docs/effects.md)");
   }
-  const numeric::Effects& e = sweep.base_effects;
-  if ((vary == "restitution" && e.compliant()) || ((vary == "stiffness" || vary == "damping") && e.restitution > 0))
-    throw BadInput("vary", vary + ": restitution and compliance both model the impact; give one of them");
-  if ((vary == "stiffness" || vary == "damping") && !e.compliant())
-    throw BadInput("vary", vary + ": the case has no [effects] compliance to vary (give one in the case file)");
+  if (numeric::adds_contact_law(sweep.varied, sweep.base_effects))
+    throw BadInput("vary", numeric::contact_law_message(vary));
+  if (const std::string missing = numeric::missing_effect(sweep.varied, sweep.base_effects); !missing.empty())
+    throw BadInput("vary", missing);
 }
 
 CaseSweep case_sweep(const SweepRequest& r) {
   if (r.vary.empty()) throw BadInput("vary", "required for a case (or use fig31 / fig32 as the target)");
-  const auto found = std::find_if(varied.begin(), varied.end(), [&](const Varied& v) { return v.name == r.vary; });
-  if (found == varied.end()) throw BadInput("vary", "unknown parameter '" + r.vary + "' (" + varied_names() + ")");
+  const std::optional<numeric::VariedParameter> found = numeric::varied_parameter(r.vary);
+  if (!found) throw BadInput("vary", "unknown parameter '" + r.vary + "' (" + varied_names() + ")");
   for (const auto& [name, value] : {std::pair{"from", &r.from}, std::pair{"to", &r.to}}) {
     if (!*value) throw BadInput(name, "required for a case");
     if (!std::isfinite(**value)) throw BadInput(name, "not finite, got " + detail::number_text(**value));
   }
   const Case c = Case::load(r.target);
-  CaseSweep sweep{c.id() + ":" + r.vary, c.parameters(), c.effects(), found->set, *r.from, *r.to, r.points};
+  CaseSweep sweep{c.id() + ":" + r.vary, c.parameters(), c.effects(), *found, *r.from, *r.to, r.points};
   check_ends(sweep, r.vary);
   return sweep;
 }

@@ -4,6 +4,9 @@
 // nominal value.
 #include "internal.hpp"
 
+#include "backlash/model/effect_table.hpp"
+
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -31,80 +34,75 @@ std::vector<std::vector<double>> EffectCandidate::scan() const {
   return points;
 }
 
+namespace {
+
+/// The nominal backlash's candidate is tried after the effects of STEP_RANK below it.
+constexpr int kBacklashSizeRank = 7;
+
+/// The model's own scale of a candidate range (model::CandidateScale).
+double scale_of(model::CandidateScale scale, const numeric::Parameters& p, double step) {
+  switch (scale) {
+    case model::CandidateScale::StepTorque: return p.K * std::fabs(step);  // the drive at the start of the step
+    case model::CandidateScale::Gain: return p.K;
+    case model::CandidateScale::ServoPeriod: return numeric::servo_period(p);
+    case model::CandidateScale::Absolute:
+    case model::CandidateScale::DampingRatio: return 1;
+  }
+  return 1;
+}
+
+/// The candidate of an effect of the table: its parameters' ranges, scaled; applying it sets
+/// them (a damping from its ratio ζ = cc/(2√(kc·m)), m the reduced inertia) and, for a
+/// contact law, puts every other contact law back to its neutral values.
+EffectCandidate table_candidate(const model::EffectInfo& effect, const numeric::Parameters& p, double step) {
+  EffectCandidate c;
+  c.effect = std::string(effect.key);
+  for (std::size_t i = effect.first; i < effect.first + effect.count; ++i) {
+    const model::EffectParameterInfo& parameter = model::effect_parameters[i];
+    const double s = scale_of(parameter.scale, p, step);
+    c.ranges.push_back({std::string(parameter.fit_name), parameter.low * s, parameter.high * s, parameter.logarithmic});
+  }
+  const double reduced_inertia = p.Jm * p.JL / (p.Jm + p.JL);
+  c.apply = [&effect, reduced_inertia](const ModelPoint& b, const std::vector<double>& v) {
+    ModelPoint m = b;
+    for (std::size_t k = 0; k < effect.count; ++k) {
+      const model::EffectParameterInfo& parameter = model::effect_parameters[effect.first + k];
+      model::field(m.e, parameter.id) = parameter.scale == model::CandidateScale::DampingRatio
+                                            ? 2 * v[k] * std::sqrt(v[k - 1] * reduced_inertia)
+                                            : v[k];
+    }
+    if (effect.contact_law)
+      for (const model::EffectInfo& other : model::effects_table)
+        if (&other != &effect && other.contact_law)
+          for (std::size_t i = other.first; i < other.first + other.count; ++i)
+            model::field(m.e, model::effect_parameters[i].id) = model::effect_parameters[i].neutral;
+    return m;
+  };
+  return c;
+}
+
+}  // namespace
+
 const std::vector<std::string>& names() {
-  static const std::vector<std::string> all{"coulomb_motor", "coulomb_load", "restitution", "saturation",
-                                            "compliance",    "delay",        "backlash_size", "torque_offset"};
+  static const std::vector<std::string> all =
+      model::ranked_effects(&model::EffectInfo::step_rank, {{kBacklashSizeRank, "backlash_size"}});
   return all;
 }
 
 EffectCandidate candidate_for(const std::string& effect, const ModelPoint& base, double step) {
   const numeric::Parameters& p = base.p;
-  const double torque = p.K * std::fabs(step);  // the drive at the start of the step
-  const double period = numeric::servo_period(p);
-  const double reduced_inertia = p.Jm * p.JL / (p.Jm + p.JL);
+  if (const model::EffectInfo* row = model::effect_keyed(effect)) return table_candidate(*row, p, step);
+  if (effect != "backlash_size") throw std::invalid_argument("unknown effect '" + effect + "'");
   EffectCandidate c;
   c.effect = effect;
-  using Values = std::vector<double>;
-  if (effect == "coulomb_motor" || effect == "coulomb_load") {
-    const bool motor = effect == "coulomb_motor";
-    c.ranges = {{"torque", 1e-4 * torque, 0.3 * torque, true}};
-    c.apply = [motor](const ModelPoint& b, const Values& v) {
-      ModelPoint m = b;
-      (motor ? m.e.coulomb_motor : m.e.coulomb_load) = v[0];
-      return m;
-    };
-  } else if (effect == "restitution") {
-    c.ranges = {{"e", 0.02, 0.95, false}};
-    c.apply = [](const ModelPoint& b, const Values& v) {
-      ModelPoint m = b;
-      m.e.restitution = v[0];
-      m.e.mesh_stiffness = INFINITY;  // the rigid impact law replaces a compliant mesh
-      m.e.mesh_damping = 0;
-      return m;
-    };
-  } else if (effect == "saturation") {
-    c.ranges = {{"limit", 0.02 * torque, 1.0 * torque, true}};
-    c.apply = [](const ModelPoint& b, const Values& v) {
-      ModelPoint m = b;
-      m.e.saturation = v[0];
-      return m;
-    };
-  } else if (effect == "compliance") {
-    // stiffness, and the damping through its ratio ζ = cc/(2√(kc·m)), m the reduced inertia
-    c.ranges = {{"stiffness", 1.0 * p.K, 1e5 * p.K, true}, {"damping", 0.02, 4.0, true}};
-    c.apply = [reduced_inertia](const ModelPoint& b, const Values& v) {
-      ModelPoint m = b;
-      m.e.mesh_stiffness = v[0];
-      m.e.mesh_damping = 2 * v[1] * std::sqrt(v[0] * reduced_inertia);
-      m.e.restitution = 0;
-      return m;
-    };
-  } else if (effect == "delay") {
-    c.ranges = {{"tau", 1e-3 * period, 0.1 * period, true}};
-    c.apply = [](const ModelPoint& b, const Values& v) {
-      ModelPoint m = b;
-      m.e.delay = v[0];
-      return m;
-    };
-  } else if (effect == "backlash_size") {
-    const double b0 = p.backlash;
-    c.ranges = {b0 > 0 ? ParameterRange{"backlash", 0.05 * b0, 4.0 * b0, true}
-                       : ParameterRange{"backlash", 1e-3 * std::fabs(step), 0.5 * std::fabs(step), true}};
-    c.apply = [](const ModelPoint& b, const Values& v) {
-      ModelPoint m = b;
-      m.p.backlash = v[0];
-      return m;
-    };
-  } else if (effect == "torque_offset") {
-    c.ranges = {{"torque", -0.2 * torque, 0.2 * torque, false}};
-    c.apply = [](const ModelPoint& b, const Values& v) {
-      ModelPoint m = b;
-      m.e.torque_offset = v[0];
-      return m;
-    };
-  } else {
-    throw std::invalid_argument("unknown effect '" + effect + "'");
-  }
+  const double b0 = p.backlash;
+  c.ranges = {b0 > 0 ? ParameterRange{"backlash", 0.05 * b0, 4.0 * b0, true}
+                     : ParameterRange{"backlash", 1e-3 * std::fabs(step), 0.5 * std::fabs(step), true}};
+  c.apply = [](const ModelPoint& b, const std::vector<double>& v) {
+    ModelPoint m = b;
+    m.p.backlash = v[0];
+    return m;
+  };
   return c;
 }
 

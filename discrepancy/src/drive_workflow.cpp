@@ -7,6 +7,7 @@
 
 #include "backlash/measurements/inverse_dynamics_signals.hpp"
 #include "backlash/discrepancy/measured_drive_simulation.hpp"
+#include "backlash/model/effect_table.hpp"
 
 #include <Eigen/Dense>
 #include <boost/math/tools/minima.hpp>
@@ -20,8 +21,8 @@
 
 namespace backlash::discrepancy {
 
-const std::vector<std::string>& drive_vocabulary() {
-  static const std::vector<std::string> vocabulary{"coulomb_motor", "torque_offset", "delay", "saturation"};
+const std::vector<std::string>& drive_vocabulary() {  // the table of effects' DRIVE_RANK order
+  static const std::vector<std::string> vocabulary = model::ranked_effects(&model::EffectInfo::drive_rank);
   return vocabulary;
 }
 

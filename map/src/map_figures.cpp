@@ -4,6 +4,7 @@
 // (docs/map-figures.md).
 #include "backlash/map/figures.hpp"
 
+#include "backlash/model/effect_table.hpp"
 #include "backlash/reports/plot.hpp"
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -69,12 +71,14 @@ std::string literal(const std::string& text) {
 // The texts below never put a space right after a sub/superscript: librsvg drops a space
 // at the edge of gnuplot's <tspan> pieces, even a no-break one ("J_{m} + J_{L}" reads "Jm+ JL").
 struct ParameterText {
-  const char* name;
-  const char* symbol;       // gnuplot enhanced text
-  const char* description;  // with the unit: docs/physics.md (rad, s, torques in N·m), docs/effects.md
+  std::string name;
+  std::string symbol;       // gnuplot enhanced text
+  std::string description;  // with the unit: docs/physics.md (rad, s, torques in N·m), docs/effects.md
 };
 
-const ParameterText* parameter_text(const std::string& name) {
+/// The structure's texts here; an effect parameter's from the table of effects (SYMBOL,
+/// DESCRIPTION (UNIT)).
+std::optional<ParameterText> parameter_text(const std::string& name) {
   static const ParameterText table[] = {
       {"Jm", "J_{m}", "motor inertia (kg·m^{2})"},
       {"JL", "J_{L}", "load inertia (kg·m^{2})"},
@@ -84,28 +88,23 @@ const ParameterText* parameter_text(const std::string& name) {
       {"backlash", "b", "backlash (rad)"},
       {"reference", "θ_{R}", "reference step (rad)"},
       {"JL_over_Jm", "J_{L}/J_{m}", "inertia ratio, (J_{m}+J_{L}) kept (dimensionless)"},
-      {"FL_over_F", "F_{L}/F", "load share of F, (F_{m}+F_{L}) kept (dimensionless)"},
-      {"coulomb_motor", "T_{m}", "Coulomb friction on the motor (N·m)"},
-      {"coulomb_load", "T_{L}", "Coulomb friction on the load (N·m)"},
-      {"restitution", "e", "restitution (dimensionless)"},
-      {"saturation", "L", "torque limit (N·m)"},
-      {"stiffness", "k_{c}", "mesh stiffness (N·m/rad)"},
-      {"damping", "c_{c}", "mesh damping (N·m·s/rad)"},
-      {"delay", "τ", "feedback delay (s)"},
-      {"torque_offset", "T_{0}", "torque offset (N·m)"}};
+      {"FL_over_F", "F_{L}/F", "load share of F, (F_{m}+F_{L}) kept (dimensionless)"}};
   for (const ParameterText& t : table)
-    if (name == t.name) return &t;
-  return nullptr;
+    if (name == t.name) return t;
+  if (const model::EffectParameterInfo* e = model::effect_parameter_named(name))
+    return ParameterText{std::string(e->name), std::string(e->symbol),
+                         std::string(e->description) + " (" + std::string(e->unit) + ")"};
+  return std::nullopt;
 }
 
 // The parameter's symbol (titles) and its axis label: symbol, what it is, unit.
 std::string symbol(const std::string& name) {
-  const ParameterText* t = parameter_text(name);
+  const std::optional<ParameterText> t = parameter_text(name);
   return t ? t->symbol : literal(name);
 }
 std::string axis_label(const std::string& name) {
-  const ParameterText* t = parameter_text(name);
-  return t ? std::string(t->symbol) + ", " + t->description : literal(name);
+  const std::optional<ParameterText> t = parameter_text(name);
+  return t ? t->symbol + ", " + t->description : literal(name);
 }
 
 std::string file_part(const std::string& name) {

@@ -42,7 +42,8 @@ class Figures {
     p.index = r.index;
     p.x.assign(r.values.begin(), r.values.begin() + static_cast<long>(d));
     p.status = map_status_names()[static_cast<std::size_t>(r.status)];
-    p.peak_to_peak = r.values[d + 15], p.period = r.values[d + 17], p.multiplier = r.values[d + 19];
+    const std::size_t results = d + MapRecord::kParameters;  // peak_to_peak, amplitude, period, ...
+    p.peak_to_peak = r.values[results], p.period = r.values[results + 2], p.multiplier = r.values[results + 4];
     p.settle_time = r.values[d + 20];
     figures_->add(p);
   }

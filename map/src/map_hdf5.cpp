@@ -96,9 +96,8 @@ MapHdf5::MapHdf5(const std::filesystem::path& path, const MapPlan& plan) : impl_
   std::vector<std::string> fields = {"#index", "%status"};
   std::vector<std::string> boundary = {"#along", "#lower", "#upper", "#appears"};
   for (const MapAxis& a : plan.request().vary) fields.push_back("x_" + a.name), boundary.push_back("x_" + a.name);
-  for (const char* f : {"Jm", "Fm", "JL", "FL", "K", "backlash", "reference", "coulomb_motor", "coulomb_load",
-                        "restitution", "saturation", "stiffness", "damping", "delay", "torque_offset", "peak_to_peak",
-                        "amplitude", "period", "separation_velocity", "multiplier", "settle_time"})
+  for (const std::string& f : numeric::point_column_names()) fields.push_back(f);
+  for (const char* f : {"peak_to_peak", "amplitude", "period", "separation_velocity", "multiplier", "settle_time"})
     fields.push_back(f);
   for (const char* f : {"bracket_low", "bracket_high", "#evaluations"}) boundary.push_back(f);
   m.open_table(m.points, "points", fields);

@@ -4,6 +4,8 @@
 
 #include "map_text.hpp"
 
+#include "backlash/numeric/varied_parameter.hpp"
+
 #include <boost/random/sobol.hpp>
 
 #include <algorithm>
@@ -17,16 +19,9 @@ using api::BadInput;
 
 namespace {
 
-const char* map_names =
-    "Jm, Fm, JL, FL, K, backlash, reference, JL_over_Jm, FL_over_F, coulomb_motor, coulomb_load, restitution, "
-    "saturation, stiffness, damping, delay, torque_offset";
+const std::string map_names = numeric::varied_parameter_names(", ");
 
-bool known_name(const std::string& v) {
-  static const std::set<std::string> names = {"Jm", "Fm", "JL", "FL", "K", "backlash", "reference", "JL_over_Jm",
-                                              "FL_over_F", "coulomb_motor", "coulomb_load", "restitution",
-                                              "saturation", "stiffness", "damping", "delay", "torque_offset"};
-  return names.count(v) > 0;
-}
+bool known_name(const std::string& v) { return numeric::varied_parameter(v).has_value(); }
 
 double parse_number(const std::string& text, const std::string& whole) {
   double value = 0;
@@ -144,34 +139,15 @@ MapPlan::MapPlan(const MapRequest& request) : request_(request), case_(api::Case
 
 void MapPlan::apply(const std::string& v, double x, numeric::Parameters& p, numeric::Effects& e) const {
   // The same assignments as `sweep` (api/src/sweep.cpp), so a one-axis map is that sweep.
-  if (v == "Jm") p.Jm = x;
-  else if (v == "Fm") p.Fm = x;
-  else if (v == "JL") p.JL = x;
-  else if (v == "FL") p.FL = x;
-  else if (v == "K") p.K = x;
-  else if (v == "backlash") p.backlash = x;
-  else if (v == "reference") p.theta_R = x;
-  else if (v == "JL_over_Jm") { const double J = base_.Jm + base_.JL; p.Jm = J / (1 + x); p.JL = J * x / (1 + x); }
-  else if (v == "FL_over_F") { const double F = base_.Fm + base_.FL; p.FL = x * F; p.Fm = F - p.FL; }
-  else if (v == "coulomb_motor") e.coulomb_motor = x;
-  else if (v == "coulomb_load") e.coulomb_load = x;
-  else if (v == "restitution") e.restitution = x;
-  else if (v == "saturation") e.saturation = x;
-  else if (v == "stiffness") e.mesh_stiffness = x;
-  else if (v == "damping") e.mesh_damping = x;
-  else if (v == "delay") e.delay = x;
-  else if (v == "torque_offset") e.torque_offset = x;
+  const numeric::VariedParameter varied = *numeric::varied_parameter(v);
+  numeric::set_varied(varied, x, p, e, base_);
   std::string text;
   detail::appendf(text, "%s = %.17g", v.c_str(), x);
-  if (!(p.Jm > 0) || !(p.JL > 0) || p.Fm < 0 || p.FL < 0 || !(p.K > 0) || p.backlash < 0)
+  if (!numeric::physical(p))
     throw BadInput("vary", text + " gives non-physical parameters (inertias and K > 0, frictions and backlash >= 0)");
-  if (e.coulomb_motor < 0 || e.coulomb_load < 0 || e.restitution < 0 || e.restitution >= 1 || !(e.saturation > 0) ||
-      !(e.mesh_stiffness > 0) || e.mesh_damping < 0 || e.delay < 0)
-    throw BadInput("vary", text + " is outside the effect's range (docs/effects.md)");
-  if (e.restitution > 0 && e.compliant())
-    throw BadInput("vary", v + ": restitution and compliance both model the impact; give one of them");
-  if ((v == "stiffness" || v == "damping") && !e.compliant())
-    throw BadInput("vary", v + ": the case has no [effects] compliance to vary (give one in the case file)");
+  if (!numeric::admissible(e)) throw BadInput("vary", text + " is outside the effect's range (docs/effects.md)");
+  if (numeric::contact_laws_clash(e)) throw BadInput("vary", numeric::contact_law_message(v));
+  if (const std::string missing = numeric::missing_effect(varied, e); !missing.empty()) throw BadInput("vary", missing);
 }
 
 long MapPlan::stride(int axis) const {

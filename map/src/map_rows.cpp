@@ -1,6 +1,7 @@
 // map_rows.cpp — a map's rows: computed in order (run_map), written as CSV, and the
 // cycle/no-cycle boundary solved along grid lines (map/map.hpp).
 #include "backlash/map/map.hpp"
+#include "backlash/numeric/varied_parameter.hpp"
 
 #include "map_output.hpp"
 
@@ -36,9 +37,11 @@ void append_quoted(std::string& out, const std::string& text) {
   out += '"';
 }
 
-const char* parameter_columns =
-    "Jm,Fm,JL,FL,K,backlash,reference,coulomb_motor,coulomb_load,restitution,saturation,stiffness,damping,delay,"
-    "torque_offset";
+std::string parameter_columns() {
+  std::string columns;
+  for (const std::string& name : numeric::point_column_names()) columns += (columns.empty() ? "" : ",") + name;
+  return columns;
+}
 
 }  // namespace
 
@@ -46,7 +49,7 @@ std::string map_csv_header(const MapPlan& plan) {
   std::string out = "index";
   for (const MapAxis& a : plan.request().vary) out += ",x_" + a.name;
   out += ",";
-  out += parameter_columns;
+  out += parameter_columns();
   out += ",status,reason,branches,peak_to_peak,amplitude,period,separation_velocity,multiplier,settle_time,settle_status\n";
   return out;
 }
@@ -56,9 +59,7 @@ std::string map_csv_row(const MapRow& r) {
   for (const double x : r.x) out += ',', append_number(out, x);
   const numeric::Parameters& p = r.row.point.parameters;
   const numeric::Effects& e = r.row.point.effects;
-  for (const double v : {p.Jm, p.Fm, p.JL, p.FL, p.K, p.backlash, p.theta_R, e.coulomb_motor, e.coulomb_load,
-                         e.restitution, e.saturation, e.mesh_stiffness, e.mesh_damping, e.delay, e.torque_offset})
-    out += ',', append_number(out, v);
+  for (const double v : numeric::point_column_values(p, e)) out += ',', append_number(out, v);
   const std::string status = api::status_of(r.row);
   const bool cycle = status == "limit_cycle";
   out += "," + status + ",";

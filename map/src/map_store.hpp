@@ -3,6 +3,7 @@
 #pragma once
 
 #include "backlash/map/map.hpp"
+#include "backlash/numeric/varied_parameter.hpp"
 
 #include <cstdint>
 #include <cstring>
@@ -26,13 +27,17 @@ inline std::int8_t map_status_code(const std::string& status) {
   return static_cast<std::int8_t>(names.size() - 1);
 }
 
-/// A record: index (int64), status code (int64), then doubles: the d varied values, the 15
-/// parameters of points.csv, peak_to_peak, amplitude, period, separation_velocity, multiplier,
-/// settle_time (NaN when the row has none).
+/// A record: index (int64), status code (int64), then doubles: the d varied values, the
+/// parameters of points.csv (numeric::point_column_names: the structure and every effect
+/// parameter), peak_to_peak, amplitude, period, separation_velocity, multiplier, settle_time
+/// (NaN when the row has none).
 struct MapRecord {
+  /// The doubles after the varied values: the parameters and the six results.
+  static constexpr std::size_t kParameters = 7 + model::kEffectParameterCount;
+  static constexpr std::size_t kValues = kParameters + 6;
   std::int64_t index = 0, status = 0;
   std::vector<double> values;
-  static std::size_t size(std::size_t d) { return 16 + 8 * (d + 21); }
+  static std::size_t size(std::size_t d) { return 16 + 8 * (d + kValues); }
 };
 
 inline void append_record(std::string& out, const MapRow& r) {
@@ -43,9 +48,7 @@ inline void append_record(std::string& out, const MapRow& r) {
   const bool cycle = head[1] == 0, computed = head[1] <= 2;
   const numeric::LimitCycle& c = r.row.cycle;
   std::vector<double> v = r.x;
-  for (const double x : {p.Jm, p.Fm, p.JL, p.FL, p.K, p.backlash, p.theta_R, e.coulomb_motor, e.coulomb_load,
-                         e.restitution, e.saturation, e.mesh_stiffness, e.mesh_damping, e.delay, e.torque_offset})
-    v.push_back(x);
+  for (const double x : numeric::point_column_values(p, e)) v.push_back(x);
   for (const double x : {c.peak_to_peak, c.amplitude, c.period, c.separation_velocity, c.multiplier})
     v.push_back(cycle ? x : NAN);
   v.push_back(computed ? r.row.settle.time : NAN);
@@ -56,8 +59,8 @@ inline MapRecord read_record(const char* bytes, std::size_t d) {
   MapRecord r;
   std::memcpy(&r.index, bytes, 8);
   std::memcpy(&r.status, bytes + 8, 8);
-  r.values.resize(d + 21);
-  std::memcpy(r.values.data(), bytes + 16, 8 * (d + 21));
+  r.values.resize(d + MapRecord::kValues);
+  std::memcpy(r.values.data(), bytes + 16, 8 * (d + MapRecord::kValues));
   return r;
 }
 

@@ -20,6 +20,7 @@
 #include <cstring>
 #include <fstream>
 #include <initializer_list>
+#include <span>
 #include <sstream>
 #include <string_view>
 
@@ -222,7 +223,7 @@ long line_of(const toml::node& node, long fallback) {
   return line > 0 ? line : fallback;
 }
 
-std::string join(std::initializer_list<std::string_view> names) {
+std::string join(std::span<const std::string_view> names) {
   std::string joined;
   for (std::string_view name : names) {
     if (!joined.empty()) joined += ", ";
@@ -370,6 +371,10 @@ class CaseFileReader {
   /// Rejects the key on the earliest line that is not in `allowed`.
   void reject_unknown_keys(const toml::table& table, const std::string& table_prefix,
                            std::initializer_list<std::string_view> allowed) const {
+    reject_unknown_keys(table, table_prefix, std::span<const std::string_view>(allowed.begin(), allowed.size()));
+  }
+  void reject_unknown_keys(const toml::table& table, const std::string& table_prefix,
+                           std::span<const std::string_view> allowed) const {
     const toml::key* earliest_unknown = nullptr;
     long earliest_line = 0;
     for (auto&& [key, node] : table) {
@@ -437,51 +442,67 @@ class CaseFileReader {
     return number.value;
   }
 
-  /// [effects] (docs/effects.md): every entry optional, exact, checked.
+  /// One parameter of the table of effects (effect_table.hpp) at `node`, checked against its
+  /// admissible values; `key` is its dotted case-file key.
+  Rational read_effect_parameter(const toml::node& node, const EffectParameterInfo& parameter,
+                                 const std::string& key) const {
+    if (parameter.admissible == Admissible::Any) return read_number(node, key).value;
+    const ExactNumber number = read_number(node, key);
+    const Rational& x = number.value;
+    const bool admitted = parameter.admissible == Admissible::NonNegative ? x >= 0
+                          : parameter.admissible == Admissible::Positive  ? x > 0
+                                                                           : x >= 0 && x < 1;
+    if (!admitted) fail(line_of(node, 1), key, std::string(parameter.problem) + " (got " + number.as_written + ")");
+    return x;
+  }
+
+  /// An effect of several parameters, KEY = { ... } (every parameter required).
+  void read_effect_table(const toml::node& entry, const EffectInfo& effect, long header_line, Effects& effects) const {
+    const std::string prefix = "effects." + std::string(effect.key);
+    const toml::table& table = require_table(entry, prefix);
+    const long table_line = line_of(table, header_line);
+    std::vector<std::string_view> keys;
+    for (std::size_t i = effect.first; i < effect.first + effect.count; ++i) keys.push_back(effect_parameters[i].key);
+    reject_unknown_keys(table, prefix, keys);
+    for (std::size_t i = effect.first; i < effect.first + effect.count; ++i) {
+      const EffectParameterInfo& parameter = effect_parameters[i];
+      const toml::node& node = require(table, prefix, table_line, parameter.key);
+      field(effects, parameter.id) = read_effect_parameter(node, parameter, dotted(prefix, parameter.key));
+    }
+  }
+
+  /// [effects] (docs/effects.md): every entry optional, exact, checked by the table of effects
+  /// (effect_table.hpp); the effects of one parameter first, then those written as tables.
   Effects read_effects(const toml::node& node, long fallback_line) const {
     const toml::table& table = require_table(node, "effects");
     const long header_line = line_of(table, fallback_line);
-    reject_unknown_keys(table, "effects",
-                        {"coulomb_motor", "coulomb_load", "restitution", "saturation", "compliance", "delay",
-                         "torque_offset"});
+    std::vector<std::string_view> keys;
+    for (const EffectInfo& effect : effects_table) keys.push_back(effect.key);
+    reject_unknown_keys(table, "effects", keys);
     Effects effects;
-    const auto non_negative = [](const Rational& value) { return value >= 0; };
-    const auto positive = [](const Rational& value) { return value > 0; };
-    if (const toml::node* entry = table.get("coulomb_motor"))
-      effects.coulomb_motor = read_effect_number(*entry, "effects.coulomb_motor", non_negative,
-                                                 "negative Coulomb torque; a friction torque must be >= 0");
-    if (const toml::node* entry = table.get("coulomb_load"))
-      effects.coulomb_load = read_effect_number(*entry, "effects.coulomb_load", non_negative,
-                                                "negative Coulomb torque; a friction torque must be >= 0");
-    if (const toml::node* entry = table.get("restitution"))
-      effects.restitution = read_effect_number(
-          *entry, "effects.restitution", [](const Rational& e) { return e >= 0 && e < 1; },
-          "coefficient of restitution outside [0, 1): 0 is the inelastic impact, 1 would never settle");
-    if (const toml::node* entry = table.get("saturation"))
-      effects.saturation = read_effect_number(*entry, "effects.saturation", positive,
-                                              "non-positive saturation limit; the drive torque limit must be > 0");
-    if (const toml::node* entry = table.get("delay"))
-      effects.delay = read_effect_number(*entry, "effects.delay", non_negative, "negative delay; tau must be >= 0");
-    if (const toml::node* entry = table.get("torque_offset"))
-      effects.torque_offset = read_number(*entry, "effects.torque_offset").value;
-    if (const toml::node* entry = table.get("compliance")) {
-      const toml::table& mesh = require_table(*entry, "effects.compliance");
-      const long mesh_line = line_of(mesh, header_line);
-      reject_unknown_keys(mesh, "effects.compliance", {"stiffness", "damping"});
-      Compliance compliance;
-      compliance.stiffness =
-          read_effect_number(require(mesh, "effects.compliance", mesh_line, "stiffness"), "effects.compliance.stiffness",
-                             positive, "non-positive mesh stiffness; a spring must be > 0 (omit the effect for a rigid mesh)");
-      compliance.damping =
-          read_effect_number(require(mesh, "effects.compliance", mesh_line, "damping"), "effects.compliance.damping",
-                             non_negative, "negative mesh damping; it must be >= 0");
-      effects.compliance = compliance;
-      if (effects.restitution != 0)
-        fail(line_of(*table.get("restitution"), header_line), "effects.restitution",
-             "restitution and compliance both model the impact (a compliant mesh has its own rebound, set by its "
-             "damping); give one of them");
-    }
+    for (const bool single : {true, false})
+      for (const EffectInfo& effect : effects_table) {
+        const toml::node* entry = table.get(effect.key);
+        if (entry == nullptr || effect.single() != single) continue;
+        if (single)
+          field(effects, effect.primary().id) =
+              read_effect_parameter(*entry, effect.primary(), "effects." + std::string(effect.key));
+        else
+          read_effect_table(*entry, effect, header_line, effects);
+        check_one_contact_law(table, effect, header_line, effects);
+      }
     return effects;
+  }
+
+  /// Two contact laws (restitution, compliance) cannot be combined: the later one read is refused.
+  void check_one_contact_law(const toml::table& table, const EffectInfo& effect, long header_line,
+                             const Effects& effects) const {
+    if (!effect.contact_law || !effects.has(effect)) return;
+    for (const EffectInfo& other : effects_table)
+      if (&other != &effect && other.contact_law && effects.has(other) && other.single())
+        fail(line_of(*table.get(other.key), header_line), "effects." + std::string(other.key),
+             std::string(other.key) + " and " + std::string(effect.key) +
+                 " both model the impact (a compliant mesh has its own rebound, set by its damping); give one of them");
   }
 
   std::string read_name(const toml::node& node) const {
@@ -612,6 +633,17 @@ CaseSpec parse_case(const std::string& contents, const std::filesystem::path& fi
     throw CaseFileError(file, line > 0 ? line : 1, "syntax", std::string(error.description()));
   }
   return CaseFileReader(file, contents).read(root);
+}
+
+bool Effects::has(const EffectInfo& effect) const {
+  const std::optional<Rational>& value = field(*this, effect.primary().id);
+  return value && (effect.primary().neutral == kAbsent || *value != Rational(effect.primary().neutral));
+}
+
+bool Effects::any() const {
+  for (const EffectInfo& effect : effects_table)
+    if (has(effect)) return true;
+  return false;
 }
 
 const std::vector<std::string>& fittable_parameters() {

@@ -192,7 +192,7 @@ void contact_system(const Parameters& p, const Effects& e, const Mode& m, const 
   const double J = p.Jm + p.JL, F = p.Fm + p.FL;
   const double T = e.coulomb_motor + e.coulomb_load;
   constexpr double eps = std::numeric_limits<double>::epsilon();
-  const double offset = std::fabs(e.torque_offset);
+  const double offset = std::fabs(drive_constant(e, 0));
   const double theta_o0 = measured(p, start);
   const bool linear_drive = m.regime == 0 && !drive_external;
   LinearSegment& s = sys.segment;
@@ -202,12 +202,12 @@ void contact_system(const Parameters& p, const Effects& e, const Mode& m, const 
   s.A(0, 1) = 1;
   s.A(1, 1) = -F / J;
   if (linear_drive) {  // z = (d, ω), d = θo − θR − y*: J d'' + F d' + K d = 0
-    const double y_star = (e.torque_offset - T * m.slip_motor) / p.K;
+    const double y_star = (drive_constant(e, 0) - T * m.slip_motor) / p.K;
     s.A(1, 0) = -p.K / J;
     sys.z0 << theta_o0 - p.theta_R - y_star, omega0;
     sys.z0_noise(0) = 4 * eps * (std::fabs(theta_o0) + std::fabs(p.theta_R) + (offset + T) / p.K);
   } else {  // z = (Δ, ω): J Δ'' + F Δ' = D − T s
-    const double drive = drive_external ? 0.0 : m.regime * e.saturation + e.torque_offset;
+    const double drive = drive_external ? 0.0 : drive_constant(e, m.regime);
     s.c(1) = (drive - T * m.slip_motor) / J;
     sys.c_magnitude(1) = ((drive_external ? 0.0 : e.saturation + offset) + T) / J;
     if (drive_external) sys.drive_column(1) = 1 / J;
@@ -247,7 +247,7 @@ void add_mesh_coupling(const Parameters& p, const Effects& e, const Mode& m, con
 ModeSystem mode_system(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start,
                        bool drive_external) {
   constexpr double eps = std::numeric_limits<double>::epsilon();
-  const double offset = std::fabs(e.torque_offset);
+  const double offset = std::fabs(drive_constant(e, 0));
   ModeSystem sys;
   const int n = m.kind == ModeKind::Contact ? 2 : 4;
   sys.segment = LinearSegment{SmallMatrix::Zero(n, n), SmallVector::Zero(n)};
@@ -301,7 +301,7 @@ ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const H
   if (m.kind == ModeKind::Contact) {
     if (m.slip_motor == 0) return;
     if (m.regime == 0) {
-      y_star_ = (e.torque_offset - T * m.slip_motor) / p.K;
+      y_star_ = (drive_constant(e, 0) - T * m.slip_motor) / p.K;
       alpha_ = F / (2 * J);
       w2_ = p.K / J;
     } else {
@@ -326,7 +326,7 @@ ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const H
     gm_ = segment_.c(1);
   } else if (at_motor(p)) {
     motor_form_ = 2;  // its own closed loop
-    y_star_ = (e.torque_offset - e.coulomb_motor * m.slip_motor) / p.K;
+    y_star_ = (drive_constant(e, 0) - e.coulomb_motor * m.slip_motor) / p.K;
     alpha_m_ = p.Fm / (2 * p.Jm);
     w2_m_ = p.K / p.Jm;
   } else {

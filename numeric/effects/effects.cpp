@@ -6,42 +6,46 @@
 
 namespace backlash::numeric {
 
+bool Effects::has(const model::EffectInfo& effect) const {
+  return !effect.primary().is_neutral(model::field(*this, effect.primary().id));
+}
+
+bool Effects::any() const {
+  for (const model::EffectInfo& effect : model::effects_table)
+    if (has(effect)) return true;
+  return false;
+}
+
 std::string Effects::describe() const {
   std::ostringstream out;
   out.precision(12);
   const char* separator = "";
-  auto item = [&](const char* name, double value) {
-    out << separator << name << "=" << value;
-    separator = ", ";
-  };
-  if (coulomb_motor > 0) item("coulomb_motor", coulomb_motor);
-  if (coulomb_load > 0) item("coulomb_load", coulomb_load);
-  if (restitution != 0) item("restitution", restitution);
-  if (saturating()) item("saturation", saturation);
-  if (compliant()) {
-    item("stiffness", mesh_stiffness);
-    item("damping", mesh_damping);
+  for (const model::EffectInfo& effect : model::effects_table) {
+    if (!has(effect)) continue;
+    for (std::size_t i = effect.first; i < effect.first + effect.count; ++i) {
+      const model::EffectParameterInfo& parameter = model::effect_parameters[i];
+      out << separator << parameter.name << "=" << model::field(*this, parameter.id);
+      separator = ", ";
+    }
   }
-  if (delayed()) item("delay", delay);
-  if (torque_offset != 0) item("torque_offset", torque_offset);
   const std::string text = out.str();
   return text.empty() ? "none" : text;
 }
 
 Effects effects_of(const model::CaseSpec& spec) {
-  const model::Effects& m = spec.effects;
   Effects e;
-  e.coulomb_motor = model::to_double(m.coulomb_motor);
-  e.coulomb_load = model::to_double(m.coulomb_load);
-  e.restitution = model::to_double(m.restitution);
-  if (m.saturation) e.saturation = model::to_double(*m.saturation);
-  if (m.compliance) {
-    e.mesh_stiffness = model::to_double(m.compliance->stiffness);
-    e.mesh_damping = model::to_double(m.compliance->damping);
-  }
-  e.delay = model::to_double(m.delay);
-  e.torque_offset = model::to_double(m.torque_offset);
+  for (const model::EffectParameterInfo& parameter : model::effect_parameters)
+    if (const std::optional<model::Rational>& value = model::field(spec.effects, parameter.id))
+      model::field(e, parameter.id) = model::to_double(*value);
   return e;
+}
+
+double drive_constant(const Effects& e, int regime) {
+  return regime == 0 ? e.torque_offset : regime * e.saturation + e.torque_offset;
+}
+
+double drive_constant_bound(const Effects& e) {
+  return e.saturating() ? e.saturation + std::fabs(e.torque_offset) : std::fabs(e.torque_offset);
 }
 
 int drive_regime(const Parameters& p, const Effects& e, double theta_o_fed_back) {
@@ -51,8 +55,7 @@ int drive_regime(const Parameters& p, const Effects& e, double theta_o_fed_back)
 }
 
 double drive_torque_in_regime(const Parameters& p, const Effects& e, double theta_o_fed_back, int regime) {
-  const double clipped = regime == 0 ? p.K * (p.theta_R - theta_o_fed_back) : regime * e.saturation;
-  return clipped + e.torque_offset;
+  return regime == 0 ? p.K * (p.theta_R - theta_o_fed_back) + drive_constant(e, 0) : drive_constant(e, regime);
 }
 
 double drive_torque(const Parameters& p, const Effects& e, double theta_o_fed_back) {

@@ -110,8 +110,8 @@ class DelayLine {
   Jet drive(double t) const {
     const Jet y = theta_o(t - e_.delay);
     const double d = p_.K * (p_.theta_R - y.value);
-    if (e_.saturating() && std::fabs(d) > e_.saturation) return {std::copysign(e_.saturation, d) + e_.torque_offset, 0, 0};
-    return {d + e_.torque_offset, -p_.K * y.rate, -p_.K * y.acceleration};
+    if (e_.saturating() && std::fabs(d) > e_.saturation) return {drive_constant(e_, d > 0 ? 1 : -1), 0, 0};
+    return {d + drive_constant(e_, 0), -p_.K * y.rate, -p_.K * y.acceleration};
   }
 
   /// The times where the delayed demand crosses ±L, with the regime after each.

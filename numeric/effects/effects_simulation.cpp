@@ -30,10 +30,9 @@ detail::ModeFunctionals functionals_of(const Parameters& p, const Effects& e, co
   f.gap = of(flow.gap_functional());
   f.dimension = static_cast<int>(flow.segment().A.rows());
   if (flow.mode().regime == 0)
-    f.drive = f.theta_o_error.scaled(-p.K).shifted(e.torque_offset);
+    f.drive = f.theta_o_error.scaled(-p.K).shifted(drive_constant(e, 0));
   else
-    f.drive = Functional{SmallRow::Zero(f.dimension), flow.mode().regime * e.saturation + e.torque_offset,
-                         e.saturation + std::fabs(e.torque_offset), 0};
+    f.drive = Functional{SmallRow::Zero(f.dimension), drive_constant(e, flow.mode().regime), drive_constant_bound(e), 0};
   return f;
 }
 

@@ -119,21 +119,19 @@ EffectValidationResult validate_effects(const ValidatedEvaluator& nominal, const
 }
 
 std::string ValidatedModelFamily::structure(const Effects& e) {
-  std::string key;
-  key += e.coulomb_motor > 0 ? 'm' : '-';
-  key += e.coulomb_load > 0 ? 'l' : '-';
-  key += e.restitution > 0 ? 'e' : '-';
-  key += e.saturating() ? 's' : '-';
-  key += e.compliant() ? 'k' : '-';
-  key += e.delayed() ? 'd' : '-';
-  key += e.torque_offset != 0 ? 'o' : '-';
+  std::string key;  // one character per effect of the table: '+' present, '-' absent
+  for (const model::EffectInfo& effect : model::effects_table) key += e.has(effect) ? '+' : '-';
   return key;
 }
 
 std::vector<double> ValidatedModelFamily::coordinates(const Parameters& p, const Effects& e) {
-  return {p.Jm, p.Fm, p.JL, p.FL, p.K, p.theta_R, p.backlash, e.coulomb_motor, e.coulomb_load, e.restitution,
-          e.saturating() ? e.saturation : 0.0, e.compliant() ? e.mesh_stiffness : 0.0, e.mesh_damping, e.delay,
-          e.torque_offset, p.measured_at == model::MeasuredAt::Motor ? 1.0 : 0.0};
+  std::vector<double> x{p.Jm, p.Fm, p.JL, p.FL, p.K, p.theta_R, p.backlash};
+  for (const model::EffectParameterInfo& parameter : model::effect_parameters) {
+    const double value = model::field(e, parameter.id);
+    x.push_back(value == model::kAbsent ? 0.0 : value);  // an absent limit or mesh counts as 0
+  }
+  x.push_back(p.measured_at == model::MeasuredAt::Motor ? 1.0 : 0.0);
+  return x;
 }
 
 bool ValidatedModelFamily::validate_samples(const std::vector<std::pair<Parameters, Effects>>& samples) {

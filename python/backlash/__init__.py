@@ -67,8 +67,8 @@ def load(case=None, /, **parameters):
     """A case: load("V") (thesis case I..VIII), load("path/to/case.toml"), or the numbers
     in code — load(measured_at="load", Jm="1/2", Fm=0.1, JL=0.5, FL=0.3, K=1, backlash=0.3,
     reference=1 [, name=..., step=..., t_end=..., experiment="step"|"drive", drive_gain=...,
-    coulomb_motor=..., coulomb_load=..., restitution=..., saturation=..., stiffness=...,
-    damping=..., delay=..., torque_offset=...]) — checked by the case-file reader's rules."""
+    and any effect parameter by its name in the table of effects, docs/effects.md, e.g.
+    coulomb_load=..., stiffness=..., damping=...]) — checked by the case-file reader's rules."""
     if case is not None:
         if parameters:
             raise TypeError("load() takes a case or parameters, not both")

@@ -95,17 +95,12 @@ py::dict parameters_dict(const model::CaseSpec& s) {
       d["drive_gain"] = model::to_string(s.experiment->drive_gain);
     if (s.experiment->t_end) d["t_end"] = model::to_string(*s.experiment->t_end);
   }
-  const model::Effects& e = s.effects;
-  if (e.coulomb_motor != 0) d["coulomb_motor"] = model::to_string(e.coulomb_motor);
-  if (e.coulomb_load != 0) d["coulomb_load"] = model::to_string(e.coulomb_load);
-  if (e.restitution != 0) d["restitution"] = model::to_string(e.restitution);
-  if (e.saturation) d["saturation"] = model::to_string(*e.saturation);
-  if (e.compliance) {
-    d["stiffness"] = model::to_string(e.compliance->stiffness);
-    d["damping"] = model::to_string(e.compliance->damping);
+  for (const model::EffectInfo& effect : model::effects_table) {  // every parameter of the effects present
+    if (!s.effects.has(effect)) continue;
+    for (std::size_t i = effect.first; i < effect.first + effect.count; ++i)
+      if (const auto& v = model::field(s.effects, model::effect_parameters[i].id))
+        d[py::str(std::string(model::effect_parameters[i].name))] = model::to_string(*v);
   }
-  if (e.delay != 0) d["delay"] = model::to_string(e.delay);
-  if (e.torque_offset != 0) d["torque_offset"] = model::to_string(e.torque_offset);
   return d;
 }
 

@@ -5,7 +5,8 @@
 #   cmake -DCLOSURES=build/link_closures -P check_dependency_rules.cmake
 #
 # Fails (one line per broken rule) when
-#   - backlash_model links any library of ours (it is the bottom layer);
+#   - backlash_output links any library of ours (it is the bottom layer), or backlash_model links
+#     any but backlash_output;
 #   - backlash_numeric links the facade, the map, the report layer, discrepancy or GiNaC;
 #   - backlash_api links the report layer (backlash_reports, backlash_plot), the map or GiNaC;
 #   - the map (backlash_map, backlash_map_figures, backlash_map_mpi) links backlash_reports or GiNaC
@@ -55,10 +56,12 @@ function(forbid library why)
   endforeach()
 endfunction()
 
-# backlash_model: nothing of ours.
+# backlash_output: nothing of ours; backlash_model: backlash_output only.
 set(ours ${libraries})
+list(REMOVE_ITEM ours backlash_output)
+forbid(backlash_output "the output layer is the bottom layer: it links no library of backlash" ${ours})
 list(REMOVE_ITEM ours backlash_model)
-forbid(backlash_model "the model is the bottom layer: it links no library of backlash" ${ours})
+forbid(backlash_model "the model sits on the output layer alone: it links no other library of backlash" ${ours})
 forbid(backlash_numeric "numeric is below the facade, the map, the report and discrepancy, and never GiNaC"
   backlash_api backlash_api_derive ${map_layer} ${reports_layer} backlash_discrepancy ${ginac})
 forbid(backlash_api "the facade links neither the report layer nor the map (which is built on it) nor GiNaC"

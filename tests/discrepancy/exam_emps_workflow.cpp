@@ -155,8 +155,8 @@ TEST(EmpsWorkflow, exam_FilesAreTheSameBytesEveryTimeAndTheCorrectedModelLoads) 
   std::ofstream(file) << discrepancy::drive_corrected_case_file(first.model, first.result);
   const model::CaseSpec corrected = model::load_case(file.string());
   std::filesystem::remove(file);
-  EXPECT_EQ(model::to_double(corrected.effects.coulomb_motor), first.result.corrected_effects.coulomb_motor);
-  EXPECT_EQ(model::to_double(corrected.effects.torque_offset), first.result.corrected_effects.torque_offset);
+  EXPECT_EQ(model::to_double(corrected.effects.coulomb_motor.value()), first.result.corrected_effects.coulomb_motor);
+  EXPECT_EQ(model::to_double(corrected.effects.torque_offset.value()), first.result.corrected_effects.torque_offset);
   const auto refit = discrepancy::find_drive_discrepancy(corrected, first.estimation);
   EXPECT_TRUE(refit.effects.empty()) << "the corrected model still misses " << (refit.effects.empty() ? "" : refit.effects[0].effect);
   EXPECT_NEAR(refit.rms_before, first.result.rms_after, 1e-6 * first.result.rms_after);

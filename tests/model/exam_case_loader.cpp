@@ -231,32 +231,32 @@ TEST_F(CaseFileVariants, NoEffectsTableIsTheNominalModel) {
   const CaseSpec spec = load(valid_case_lines);
   EXPECT_FALSE(spec.effects.any());
   EXPECT_FALSE(spec.effects.saturation.has_value());
-  EXPECT_FALSE(spec.effects.compliance.has_value());
+  EXPECT_FALSE(spec.effects.mesh_stiffness.has_value());
 }
 
 TEST_F(CaseFileVariants, EffectsAreReadExactly) {
   const CaseSpec spec = load(with_effects({"coulomb_motor = 0.05", "coulomb_load = \"3/100\"", "restitution = 0.4",
                                            "saturation = 0.5", "delay = 0.05", "torque_offset = -0.02"}));
-  expect_exact(spec.effects.coulomb_motor, exact(1, 20), "effects.coulomb_motor");
-  expect_exact(spec.effects.coulomb_load, exact(3, 100), "effects.coulomb_load");
-  expect_exact(spec.effects.restitution, exact(2, 5), "effects.restitution");
+  expect_exact(spec.effects.coulomb_motor.value(), exact(1, 20), "effects.coulomb_motor");
+  expect_exact(spec.effects.coulomb_load.value(), exact(3, 100), "effects.coulomb_load");
+  expect_exact(spec.effects.restitution.value(), exact(2, 5), "effects.restitution");
   ASSERT_TRUE(spec.effects.saturation.has_value());
   expect_exact(*spec.effects.saturation, exact(1, 2), "effects.saturation");
-  expect_exact(spec.effects.delay, exact(1, 20), "effects.delay");
-  expect_exact(spec.effects.torque_offset, exact(-1, 50), "effects.torque_offset");
+  expect_exact(spec.effects.delay.value(), exact(1, 20), "effects.delay");
+  expect_exact(spec.effects.torque_offset.value(), exact(-1, 50), "effects.torque_offset");
   EXPECT_TRUE(spec.effects.any());
 }
 
 TEST_F(CaseFileVariants, ComplianceAsInlineOrStandardTable) {
   const CaseSpec inline_table = load(with_effects({"compliance = { stiffness = 400, damping = 4.5 }"}));
-  ASSERT_TRUE(inline_table.effects.compliance.has_value());
-  expect_exact(inline_table.effects.compliance->stiffness, exact(400), "stiffness");
-  expect_exact(inline_table.effects.compliance->damping, exact(9, 2), "damping");
+  ASSERT_TRUE(inline_table.effects.mesh_stiffness.has_value());
+  expect_exact(*inline_table.effects.mesh_stiffness, exact(400), "stiffness");
+  expect_exact(*inline_table.effects.mesh_damping, exact(9, 2), "damping");
   std::vector<std::string> lines = valid_case_lines;
   lines.insert(lines.end(), {"[effects.compliance]", "stiffness = 1e4", "damping = 0"});
   const CaseSpec standard = load(lines);
-  ASSERT_TRUE(standard.effects.compliance.has_value());
-  expect_exact(standard.effects.compliance->stiffness, exact(10000), "stiffness");
+  ASSERT_TRUE(standard.effects.mesh_stiffness.has_value());
+  expect_exact(*standard.effects.mesh_stiffness, exact(10000), "stiffness");
 }
 
 TEST_F(CaseFileVariants, NeutralValuesAreTheNominalModel) {

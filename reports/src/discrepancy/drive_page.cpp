@@ -3,9 +3,10 @@
 // record gives the same bytes.
 #include "backlash/reports/discrepancy_pages.hpp"
 
-#include "case_file_text.hpp"
 #include "page_json.hpp"
 #include "plots.hpp"
+
+#include "backlash/model/case_writer.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -18,9 +19,6 @@ namespace backlash::discrepancy {
 
 namespace {
 
-using detail::decimal;
-using detail::exact_or;
-using detail::toml_string;
 
 using detail::Band;
 using detail::Series;
@@ -147,37 +145,32 @@ std::string drive_to_json(const model::CaseSpec& model, const DriveDiscrepancyRe
 }
 
 std::string drive_corrected_case_file(const model::CaseSpec& spec, const DriveDiscrepancyResult& r) {
-  std::ostringstream out;
-  out << "# The model of " << spec.source.filename().string() << " corrected by `backlash discrepancy` (measured drive).\n";
-  for (const Parameter& p : r.corrected_nominal) out << "#   " << p.name << " = " << p.value << " ± " << p.uncertainty << "\n";
-  for (const Candidate& c : r.effects)
-    for (const Parameter& p : c.parameters) out << "#   " << c.effect << ": " << p.name << " = " << p.value << " ± " << p.uncertainty << "\n";
-  out << "# Torque RMS of the inverse dynamics: " << r.rms_before << " (best nominal model) -> " << r.rms_after << ".\n";
+  model::CaseFileText c;
+  c.blank_line_before_tables = true;
+  c.comments.push_back("The model of " + spec.source.filename().string() + " corrected by `backlash discrepancy` (measured drive).");
+  auto comment = [&c](const std::string& head, const auto&... numbers) {  // numbers as a stream writes them
+    std::ostringstream line;
+    line << head;
+    (line << ... << numbers);
+    c.comments.push_back(line.str());
+  };
+  for (const Parameter& p : r.corrected_nominal) comment("  " + p.name + " = ", p.value, " ± ", p.uncertainty);
+  for (const Candidate& candidate : r.effects)
+    for (const Parameter& p : candidate.parameters)
+      comment("  " + candidate.effect + ": " + p.name + " = ", p.value, " ± ", p.uncertainty);
+  comment("Torque RMS of the inverse dynamics: ", r.rms_before, " (best nominal model) -> ", r.rms_after, ".");
   const numeric::Parameters& p = r.parameters;
-  const numeric::Effects& e = r.corrected_effects;
-  out << "name = " << toml_string(spec.name + " (corrected)") << "\n";
-  out << "measured_at = \"" << model::to_string(spec.measured_at) << "\"\n";
-  out << "K = " << toml_string(model::to_string(spec.K)) << "\n";
-  out << "backlash = 0\n";
-  out << "reference = " << toml_string(model::to_string(spec.reference)) << "\n\n";
-  out << "[motor]\nJ = " << exact_or(spec.Jm, p.Jm) << "\nF = " << exact_or(spec.Fm, p.Fm) << "\n\n";
-  out << "[load]\nJ = " << exact_or(spec.JL, p.JL) << "\nF = " << exact_or(spec.FL, p.FL) << "\n\n";
-  out << "[experiment]\nkind = \"drive\"\ndrive_gain = " << toml_string(model::to_string(spec.experiment->drive_gain)) << "\n";
-  if (spec.experiment->t_end) out << "t_end = " << toml_string(model::to_string(*spec.experiment->t_end)) << "\n";
-  if (!spec.fit_free.empty()) {
-    out << "\n[fit]\nfree = [";
-    for (std::size_t i = 0; i < spec.fit_free.size(); ++i) out << (i ? ", " : "") << toml_string(spec.fit_free[i]);
-    out << "]\n";
-  }
-  if (!e.any()) return out.str();
-  const model::Effects& m = spec.effects;
-  out << "\n[effects]\n";
-  if (e.coulomb_motor > 0) out << "coulomb_motor = " << exact_or(m.coulomb_motor, e.coulomb_motor) << "\n";
-  if (e.coulomb_load > 0) out << "coulomb_load = " << exact_or(m.coulomb_load, e.coulomb_load) << "\n";
-  if (e.saturating()) out << "saturation = " << (m.saturation ? exact_or(*m.saturation, e.saturation) : decimal(e.saturation)) << "\n";
-  if (e.delayed()) out << "delay = " << exact_or(m.delay, e.delay) << "\n";
-  if (e.torque_offset != 0) out << "torque_offset = " << exact_or(m.torque_offset, e.torque_offset) << "\n";
-  return out.str();
+  c.name = spec.name + " (corrected)";
+  c.measured_at = spec.measured_at;
+  c.K = model::exact_text(spec.K), c.backlash = "0", c.reference = model::exact_text(spec.reference);
+  c.Jm = model::exact_or_decimal(spec.Jm, p.Jm), c.Fm = model::exact_or_decimal(spec.Fm, p.Fm);
+  c.JL = model::exact_or_decimal(spec.JL, p.JL), c.FL = model::exact_or_decimal(spec.FL, p.FL);
+  model::ExperimentText x{model::ExperimentKind::Drive, "", model::exact_text(spec.experiment->drive_gain), std::nullopt};
+  if (spec.experiment->t_end) x.t_end = model::exact_text(*spec.experiment->t_end);
+  c.experiment = x;
+  c.fit_free = spec.fit_free;
+  c.effects = model::fitted_effect_texts(spec.effects, r.corrected_effects);
+  return model::write_case_file(c);
 }
 
 namespace {

@@ -128,8 +128,8 @@ class Case {
 
   /// Parameters as (name, exact text) pairs — how other languages pass them (Python's
   /// load(Jm="1/2", ...)).  Names: name measured_at Jm Fm JL FL K backlash reference,
-  /// experiment ("step" | "drive") step t_end drive_gain, and the effects coulomb_motor
-  /// coulomb_load restitution saturation stiffness damping delay torque_offset.  Numbers
+  /// experiment ("step" | "drive") step t_end drive_gain, and every effect parameter by its
+  /// NAME in the table of effects (backlash/model/effect_table.hpp).  Numbers
   /// as the case file's strings: "0.3" (= 3/10), "1/3", "-2e-3", "4".  A problem is a
   /// BadInput naming the parameter: "Jm: non-positive inertia (got "0"; an inertia must be
   /// > 0)", "K: missing key", "Jx: unknown parameter (allowed: ...)".
@@ -298,8 +298,8 @@ struct SweepRequest {
   /// file) with `vary`, `from`, `to`.
   std::string target{};
   /// For a case: Jm Fm JL FL K backlash reference, JL_over_Jm (keeping Jm + JL), FL_over_F
-  /// (keeping Fm + FL), or an effect's parameter: coulomb_motor coulomb_load restitution
-  /// saturation stiffness damping delay torque_offset.
+  /// (keeping Fm + FL), or an effect's parameter by its NAME in the table of effects
+  /// (backlash/numeric/varied_parameter.hpp).
   std::string vary{};
   /// For a case: x_i = from + (to − from)·i/(points − 1).
   std::optional<double> from{}, to{};

@@ -14,9 +14,9 @@
 //      noise band (|r| > 3σ over 5 consecutive samples), and features of the
 //      record against the model (overshoot, final error, decay rate, cycle
 //      amplitude and period);
-//   3. names the missing effect: every effect of the vocabulary (effects.md:
-//      coulomb_motor, coulomb_load, restitution, saturation, compliance, delay,
-//      backlash_size, torque_offset) is added to the model in turn and fitted on
+//   3. names the missing effect: every effect of the vocabulary (the effects of the
+//      table of effects, model/effect_table.hpp, in their STEP_RANK order, and
+//      backlash_size) is added to the model in turn and fitted on
 //      seven of ten blocks of the record (the third, sixth and ninth are held out,
 //      so that they see the transient and the end alike) — a bracketing scan over
 //      the parameter's range, then, event timing making the cost non-smooth,

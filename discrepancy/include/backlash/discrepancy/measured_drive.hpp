@@ -5,7 +5,7 @@
 //     J·q'' + F·q' + Tc·sgn(q') = u(t − τ) + T0,   u = sat_L(gain · drive)
 // with J = Jm + JL, F = Fm + FL, and the effects of the vocabulary that make sense without a
 // gap: Coulomb friction Tc (coulomb_motor; on a rigid drive the motor's and the load's are
-// one friction), torque_offset T0, saturation L, delay τ.  Units are the record's own (EMPS:
+// one friction), the torque offset T0, saturation L, delay τ.  Units are the record's own (EMPS:
 // metres, newtons, kilograms).
 //
 // The comparison is in the torque domain (inverse dynamics): the torque the model needs along

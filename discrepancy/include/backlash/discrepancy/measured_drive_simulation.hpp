@@ -72,7 +72,7 @@ struct RigidDrive {
 double applied_torque(const RigidDrive& model, double drive);
 
 /// From a case's parameters and effects: J = Jm + JL, F = Fm + FL, Tc = coulomb_motor +
-/// coulomb_load, T0 = torque_offset, L = saturation, τ = delay, gain = drive_gain (K and
+/// coulomb_load, T0 = the torque offset, L = saturation, τ = delay, gain = drive_gain (K and
 /// θR are unused: the loop is open).  std::invalid_argument for what needs a gap or a
 /// mesh: backlash > 0, restitution ≠ 0, compliance.
 RigidDrive rigid_drive_of(const numeric::Parameters& p, const numeric::Effects& e, double drive_gain);

@@ -113,7 +113,7 @@ struct MapRow {
 
 /// The CSV of `backlash map` (points.csv): its header, and one row (both end in '\n').
 /// Columns: index, x_<name> for each varied parameter, Jm, Fm, JL, FL, K, backlash, reference,
-/// coulomb_motor, coulomb_load, restitution, saturation, stiffness, damping, delay, torque_offset,
+/// every effect parameter by its NAME (the table of effects' order: numeric::point_column_names),
 /// status, reason, branches, peak_to_peak, amplitude, period, separation_velocity, multiplier,
 /// settle_time, settle_status.  Numbers in the shortest text that reads back to the same double
 /// (std::to_chars); empty cells for what a row does not have; the reason quoted (RFC 4180).

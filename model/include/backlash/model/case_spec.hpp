@@ -12,6 +12,8 @@
 // This library has no GiNaC dependency: numeric/ uses it as well as symbolic/.
 #pragma once
 
+#include "backlash/model/effect_table.hpp"
+
 #include <boost/multiprecision/cpp_int.hpp>
 
 #include <filesystem>
@@ -39,30 +41,19 @@ struct Experiment {
   std::optional<Rational> t_end;
 };
 
-/// The gear mesh as a spring-damper beyond the backlash (docs/effects.md §compliance):
-/// it pushes with stiffness·δ + damping·δ̇ (δ the penetration beyond a face), never pulls.
-struct Compliance {
-  Rational stiffness;  ///< torque per radian of penetration, > 0
-  Rational damping;    ///< torque per rad/s, >= 0
-};
-
-/// The effects the thesis left out (docs/effects.md), as read from the optional
-/// [effects] table.  An absent entry is the effect at its neutral value: no
-/// Coulomb torque, the inelastic impact (e = 0), an unlimited drive, a rigid
-/// mesh, no delay, no offset.
+/// The effects the thesis left out (docs/effects.md), as read from the optional [effects]
+/// table: one exact member per parameter of the table of effects (effect_table.hpp), named
+/// by its FIELD.  An absent member is the parameter at its neutral value: no Coulomb torque,
+/// the inelastic impact (e = 0), an unlimited drive, a rigid mesh, no delay, no offset.
 struct Effects {
-  Rational coulomb_motor;              ///< Coulomb torque on the motor, >= 0 (with sticking)
-  Rational coulomb_load;               ///< Coulomb torque on the load, >= 0 (with sticking)
-  Rational restitution;                ///< Newton's coefficient e, 0 <= e < 1
-  std::optional<Rational> saturation;  ///< drive torque K(θR − θo) clipped at ±limit, limit > 0
-  std::optional<Compliance> compliance;
-  Rational delay;                      ///< τ >= 0 [s]: the fed-back angle is θo(t − τ)
-  Rational torque_offset;              ///< a constant torque on the motor shaft (any sign)
+#define BACKLASH_EFFECT_PARAMETER_MEMBER(FIELD, ...) std::optional<Rational> FIELD;
+  BACKLASH_EFFECT_PARAMETERS(BACKLASH_EFFECT_PARAMETER_MEMBER)
+#undef BACKLASH_EFFECT_PARAMETER_MEMBER
+
+  /// True when the effect is present: its first parameter given and not neutral.
+  bool has(const EffectInfo& effect) const;
   /// True when some effect differs from its neutral value.
-  bool any() const {
-    return coulomb_motor != 0 || coulomb_load != 0 || restitution != 0 || saturation || compliance || delay != 0 ||
-           torque_offset != 0;
-  }
+  bool any() const;
 };
 
 struct CaseSpec {

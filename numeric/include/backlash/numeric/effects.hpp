@@ -13,6 +13,7 @@
 #pragma once
 
 #include "backlash/model/case_spec.hpp"
+#include "backlash/model/effect_table.hpp"
 #include "backlash/numeric/hybrid_simulation.hpp"
 #include "backlash/numeric/parametric.hpp"
 
@@ -22,27 +23,35 @@
 
 namespace backlash::numeric {
 
+/// The effects as doubles: one member per row of the table of effects
+/// (backlash/model/effect_table.hpp), named by its FIELD and holding its NEUTRAL value unless
+/// set — coulomb_motor Tm, coulomb_load TL, restitution e, saturation L (∞: unlimited),
+/// mesh_stiffness kc (∞: a rigid mesh), mesh_damping cc, delay τ, the torque offset T0.
 struct Effects {
-  double coulomb_motor = 0;  ///< Tm
-  double coulomb_load = 0;   ///< TL
-  double restitution = 0;    ///< e
-  double saturation = std::numeric_limits<double>::infinity();      ///< L (∞: unlimited)
-  double mesh_stiffness = std::numeric_limits<double>::infinity();  ///< kc (∞: rigid mesh)
-  double mesh_damping = 0;   ///< cc
-  double delay = 0;          ///< τ
-  double torque_offset = 0;  ///< T0
+#define BACKLASH_EFFECT_PARAMETER_DOUBLE(FIELD, EFFECT, KEY, NAME, SYMBOL, DESCRIPTION, UNIT, NEUTRAL, ...) \
+  double FIELD = NEUTRAL;
+  BACKLASH_EFFECT_PARAMETERS(BACKLASH_EFFECT_PARAMETER_DOUBLE)
+#undef BACKLASH_EFFECT_PARAMETER_DOUBLE
 
   bool saturating() const { return std::isfinite(saturation); }
   bool compliant() const { return std::isfinite(mesh_stiffness); }
   bool coulomb() const { return coulomb_motor > 0 || coulomb_load > 0; }
   bool delayed() const { return delay > 0; }
+  /// True when the effect is present: its first parameter not neutral.
+  bool has(const model::EffectInfo& effect) const;
   /// True when some effect differs from its neutral value.
-  bool any() const {
-    return coulomb() || restitution != 0 || saturating() || compliant() || delayed() || torque_offset != 0;
-  }
-  /// "coulomb_load=0.03, restitution=0.4" (only the effects present; "none" when nominal).
+  bool any() const;
+  /// "coulomb_load=0.03, restitution=0.4" (only the effects present, every parameter of each by
+  /// its table NAME; "none" when nominal).
   std::string describe() const;
 };
+
+/// The constant part of the drive torque in a saturation regime (0 linear, ±1 clipped at ±L):
+/// regime·L + T0 (the linear part, K·(θR − θo), is added by the mode).
+double drive_constant(const Effects& e, int regime);
+
+/// A bound on the constant part of the drive over every regime: L + |T0| (|T0| when unsaturated).
+double drive_constant_bound(const Effects& e);
 
 /// The case file's [effects] table as doubles.
 Effects effects_of(const model::CaseSpec& spec);
