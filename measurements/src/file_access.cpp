@@ -6,6 +6,7 @@
 #include "backlash/measurements/measured_record.hpp"
 #include "backlash/output/atomic_file.hpp"
 #include "backlash/output/output_error.hpp"
+#include "backlash/output/target.hpp"
 
 #include <fmt/format.h>
 
@@ -30,21 +31,11 @@ namespace {
 
 std::string errno_text(int error_number) { return std::strerror(error_number); }
 
-/// What a non-regular file is, for "not a regular file (…)".
-const char* describe_file_type(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISSOCK(mode)) return "a socket";
-  if (S_ISLNK(mode)) return "a symbolic link";
-  return "not a regular file";
-}
 
 void check_metadata(const std::filesystem::path& file, const struct stat& info, std::uintmax_t max_bytes) {
   if (S_ISDIR(info.st_mode)) fail(file, "cannot read: it is a directory");
   if (!S_ISREG(info.st_mode))
-    fail(file, fmt::format("cannot read: not a regular file ({})", describe_file_type(info.st_mode)));
+    fail(file, fmt::format("cannot read: not a regular file ({})", output::describe_file_type(info.st_mode)));
   const auto size = static_cast<std::uintmax_t>(info.st_size);
   if (size > max_bytes)
     fail(file, fmt::format("file too large: {} bytes (the limit is {} bytes)", size, max_bytes));

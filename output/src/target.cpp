@@ -15,16 +15,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// What a file that is not a regular file is.
-std::string describe_file_type(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  if (S_ISFIFO(mode)) return "a FIFO";
-  if (S_ISSOCK(mode)) return "a socket";
-  if (S_ISLNK(mode)) return "a symbolic link";
-  return "not a regular file";
-}
 
 std::string out(const fs::path& target) { return "--out " + target.string(); }
 
@@ -107,6 +97,16 @@ void check_target(const fs::path& target, Target kind, const FolderOwner& owner)
     case Target::folder: return check_folder(target, owner);
     case Target::file_folder: return check_file_folder_target(target);
   }
+}
+
+std::string describe_file_type(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISLNK(mode)) return "a symbolic link";
+  return "not a regular file";
 }
 
 }  // namespace backlash::output

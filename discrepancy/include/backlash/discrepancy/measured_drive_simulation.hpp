@@ -45,7 +45,7 @@
 // form's v there is 0 or has the wrong sign, also by underflow) is set to exactly 0 and
 // decided at the start of the next piece, with that piece's drive.
 // Checked against an independent Boost.Odeint reference (piece by piece, its own
-// stick/slip handling) in tests/numeric/check_measured_drive_simulation.cpp.
+// stick/slip handling) in tests/discrepancy/check_measured_drive_simulation.cpp.
 #pragma once
 
 #include "backlash/numeric/effects.hpp"

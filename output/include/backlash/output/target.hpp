@@ -16,6 +16,8 @@
 #include <filesystem>
 #include <string>
 
+#include <sys/types.h>
+
 namespace backlash::output {
 
 enum class Target { file, folder, file_folder };
@@ -31,6 +33,9 @@ struct FolderOwner {
 
 /// Throws OutputError(bad_target) when `target` cannot receive an output of this kind.
 void check_target(const std::filesystem::path& target, Target kind, const FolderOwner& owner = {});
+
+/// What a file that is not a regular file is ("a directory", "a FIFO", ...), from lstat's st_mode.
+std::string describe_file_type(mode_t mode);
 
 /// The absolute, normal form of a folder target ("dir/" → "/…/dir"); OutputError when the
 /// path cannot be made absolute.
