@@ -1,16 +1,18 @@
 // reports/src/discrepancy/case_file_text.hpp (internal) — the corrected case file's text
 // pieces (case_file.cpp): the shortest decimal that reads back as the same double, a TOML
-// basic string, and the original exact value when the fit kept it (else the decimal).
+// basic string (backlash/output/text.hpp), and the original exact value when the fit kept it
+// (else the decimal).
 #pragma once
 
 #include "backlash/model/case_spec.hpp"
+#include "backlash/output/text.hpp"
 
 #include <string>
 
 namespace backlash::discrepancy::detail {
 
 std::string decimal(double value);
-std::string quoted(const std::string& text);
+using output::toml_string;
 std::string exact_or(const model::Rational& original, double value);
 
 }  // namespace backlash::discrepancy::detail
