@@ -1,6 +1,7 @@
 // map_finish.cpp — the end of `backlash map --out DIR`: map.h5, the figures and the statuses
 // from points.bin in one pass, the cycle/no-cycle boundary solved over every rank and thread,
-// boundary.csv, map.json, and the partial folder renamed into place (map/map.hpp).
+// boundary.csv, map.json, and the partial folder committed into place (output::StagedDirectory,
+// map/map.hpp).
 #include "map_output.hpp"
 #include "map_store.hpp"
 
@@ -167,31 +168,14 @@ std::string map_json(const MapPlan& plan, const MapSummary& summary) {
   return j.dump(2) + "\n";
 }
 
-void commit(const fs::path& staging, const fs::path& target) {
-  const fs::path absolute = fs::absolute(target).lexically_normal();
-  const fs::path clean = absolute.has_filename() ? absolute : absolute.parent_path();
-  std::error_code error;
-  fs::path old;
-  if (fs::exists(fs::symlink_status(clean, error))) {
-    check_target(clean);  // still empty or a backlash output
-    std::string name = ".";  // (built step by step: GCC 12 warns falsely on "." + string)
-    name += clean.filename().string();
-    name += ".map-old";
-    old = clean.parent_path() / name;
-    fs::remove_all(old, error);
-    fs::rename(clean, old);
-  }
-  fs::rename(staging, clean);
-  if (!old.empty()) fs::remove_all(old, error);
-}
-
 }  // namespace
 
 void finish_map(const MapPlan& plan, const MapOutput& output,
-                const std::shared_ptr<const numeric::ValidatedParametricFamily>& family, MapSummary& summary) {
+                const std::shared_ptr<const numeric::ValidatedParametricFamily>& family, MapSummary& summary,
+                output::StagedDirectory* stage) {
   const bool root = !output.transport || output.transport->rank() == 0;
   const bool boundary = plan.request().boundary && plan.request().sample == "grid";
-  const fs::path staging = staging_path(output.out);
+  const fs::path staging = root ? stage->path() : fs::path();
   std::optional<MapHdf5> h5;
   Figures figures(plan, root && output.figures);
   std::vector<Crossing> crossings;
@@ -216,10 +200,13 @@ void finish_map(const MapPlan& plan, const MapOutput& output,
   if (h5) h5->close();
   if (output.figures) summary.figures_note = figures.write(staging);
   std::ofstream(staging / "map.json", std::ios::binary) << map_json(plan, summary);
-  std::ofstream(staging / ".backlash-report", std::ios::binary) << "written by backlash map\n";
   fs::remove(staging / "points.bin");
   fs::remove(staging / "checkpoint");
-  commit(staging, output.out);
+  try {
+    stage->commit();  // the marker ("written by backlash map"), then the rename onto --out
+  } catch (const output::OutputError& e) {
+    rethrow_as_bad_out(e);
+  }
 }
 
 }  // namespace backlash::map::detail

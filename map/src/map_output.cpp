@@ -1,7 +1,9 @@
 // map_output.cpp — `backlash map --out DIR`: the rows streamed into a partial folder with a
 // checkpoint at every block, on one process or over MPI ranks (MapTransport), then the final
 // files (HDF5, boundary, figures) and the atomic rename (map/map.hpp; docs/design.md,
-// "Design-space maps").
+// "Design-space maps").  The partial folder is the output layer's (backlash/output/
+// staged_directory.hpp: StagedDirectory::partial); what it holds and when it may be resumed
+// (the checkpoint) is the map's.
 #include "backlash/map/map.hpp"
 
 #include "map_output.hpp"
@@ -11,6 +13,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 namespace backlash::map {
@@ -32,30 +35,18 @@ std::string fingerprint(const MapPlan& plan, const MapOutput& output) {
   return out;
 }
 
-fs::path staging_path(const fs::path& target) {
-  const fs::path absolute = fs::absolute(target).lexically_normal();
-  const fs::path clean = absolute.has_filename() ? absolute : absolute.parent_path();
-  std::string name = ".";  // (built step by step: GCC 12 warns falsely on "." + string)
-  name += clean.filename().string();
-  name += ".map-partial";
-  return clean.parent_path() / name;
-}
-
-// The rules of reports/output_directory.hpp: a new folder, an empty one, or a report's.
-void check_target(const fs::path& target) {
-  if (target.empty()) throw BadInput("out", "empty path");
-  const fs::path absolute = fs::absolute(target).lexically_normal();
-  const fs::path clean = absolute.has_filename() ? absolute : absolute.parent_path();
-  if (clean == clean.root_path() || clean.filename() == "." || clean.filename() == "..")
-    throw BadInput("out", target.string() + ": not a folder name");
-  std::error_code error;
-  if (!fs::is_directory(clean.parent_path(), error))
-    throw BadInput("out", target.string() + ": the folder " + clean.parent_path().string() + " does not exist");
-  const fs::file_status status = fs::symlink_status(clean, error);
-  if (!fs::exists(status)) return;
-  if (!fs::is_directory(status)) throw BadInput("out", target.string() + ": exists and is not a folder");
-  if (fs::is_empty(clean, error) || fs::exists(clean / ".backlash-report")) return;
-  throw BadInput("out", target.string() + ": the folder exists and is not a backlash output; choose a new folder");
+// The output layer's refusal of a target (OutputError bad_target) in the map's words, as it has
+// always printed it: BadInput "out" ("--out: DIR: not a folder name", exit 2).  A failed write
+// (exit 1) goes on as it is.
+[[noreturn]] void rethrow_as_bad_out(const output::OutputError& e) {
+  if (e.kind() != output::OutputError::Kind::bad_target) throw e;
+  std::string message = e.what();
+  for (const char* head : {"--out: ", "--out "})
+    if (message.rfind(head, 0) == 0) {
+      message.erase(0, std::char_traits<char>::length(head));
+      break;
+    }
+  throw BadInput("out", message);
 }
 
 RowWriter::RowWriter(const fs::path& staging, const MapPlan& plan, const MapOutput& output, std::string print,
@@ -132,9 +123,14 @@ bool read_checkpoint(const fs::path& staging, const std::string& print, long& do
 namespace {
 
 // Opens the partial folder (fresh or resumed) at rank 0; returns the first point to compute.
-std::unique_ptr<detail::RowWriter> open_partial(const MapPlan& plan, const MapOutput& output) {
-  detail::check_target(output.out);
-  const fs::path staging = detail::staging_path(output.out);
+std::unique_ptr<detail::RowWriter> open_partial(const MapPlan& plan, const MapOutput& output,
+                                                std::optional<output::StagedDirectory>& stage) {
+  try {
+    stage.emplace(output::StagedDirectory::partial(output.out, detail::partial_tag, "map", detail::map_owner));
+  } catch (const output::OutputError& e) {
+    detail::rethrow_as_bad_out(e);
+  }
+  const fs::path staging = stage->path();
   const std::string print = detail::fingerprint(plan, output);
   long done = 0;
   std::uintmax_t csv = 0, bin = 0;
@@ -210,16 +206,19 @@ bool compute_distributed(const MapPlan& plan, const numeric::SweepOptions& optio
 
 }  // namespace
 
-std::filesystem::path map_partial_folder(const std::filesystem::path& out) { return detail::staging_path(out); }
+std::filesystem::path map_partial_folder(const std::filesystem::path& out) {
+  return output::StagedDirectory::partial_path(out, detail::partial_tag);
+}
 
 MapSummary write_map(const MapRequest& request, const MapOutput& output) {
   const MapPlan plan(request);
   MapTransport* t = output.transport;
   const bool root = !t || t->rank() == 0;
+  std::optional<output::StagedDirectory> stage;  // rank 0: kept unless committed (--resume)
   std::unique_ptr<detail::RowWriter> writer;
   std::string start;
   try {
-    if (root) writer = open_partial(plan, output), start = "ok " + std::to_string(writer->done());
+    if (root) writer = open_partial(plan, output, stage), start = "ok " + std::to_string(writer->done());
   } catch (const std::exception& e) {
     if (!t || t->size() == 1) throw;
     start = std::string("error ") + e.what();
@@ -248,7 +247,7 @@ MapSummary write_map(const MapRequest& request, const MapOutput& output) {
   if (root) summary.written = writer->written(), summary.kept = writer->done(), writer->close();
   summary.complete = complete;
   if (!complete) return summary;
-  detail::finish_map(plan, output, options.family, summary);
+  detail::finish_map(plan, output, options.family, summary, stage ? &*stage : nullptr);
   return summary;
 }
 

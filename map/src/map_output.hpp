@@ -1,15 +1,21 @@
 // map_output.hpp — the pieces of `write_map` (map_output.cpp, map_finish.cpp): the partial
-// folder's row writer and checkpoint, and the final files.
+// folder's row writer and checkpoint, and the final files.  The partial folder itself, the
+// --out checks and the rename into place are the output layer's (backlash/output/
+// staged_directory.hpp).
 #pragma once
 
 #include "backlash/map/map.hpp"
 
 #include "map_text.hpp"
 
+#include "backlash/output/output_error.hpp"
+#include "backlash/output/staged_directory.hpp"
+
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <string_view>
 
 namespace backlash::map::detail {
 
@@ -21,10 +27,13 @@ struct Interrupted {};
 std::string fingerprint(const MapPlan& plan, const MapOutput& output);
 /// The sweep's options for the map's points: threads, block, and the settle time's step.
 numeric::SweepOptions sweep_options(const MapPlan& plan);
-/// ".DIR.map-partial" beside DIR.
-std::filesystem::path staging_path(const std::filesystem::path& target);
-/// reports/output_directory.hpp's rules for --out (BadInput "out").
-void check_target(const std::filesystem::path& target);
+/// The partial folder of --out DIR: ".DIR.map-partial" beside it (output::StagedDirectory::partial).
+inline constexpr std::string_view partial_tag = "map-partial";
+/// Whose folders --out may replace (backlash/output/target.hpp): "… is not a backlash output".
+inline const output::FolderOwner map_owner{"backlash output"};
+/// An output::OutputError in the map's words: a refused target as BadInput "out" (its message
+/// without the leading "--out "), a failed write rethrown as it is.
+[[noreturn]] void rethrow_as_bad_out(const output::OutputError& e);
 
 /// Rank 0: appends each row to points.csv and points.bin in index order; at every block end
 /// flushes both and rewrites the checkpoint (the fingerprint, the points done, the two files'
@@ -57,8 +66,10 @@ class RowWriter {
 };
 
 /// Every rank: the final files from points.bin (rank 0), the boundary solved over all ranks,
-/// map.json, then the partial folder renamed onto --out (rank 0).
+/// map.json, then the partial folder `stage` committed onto --out (rank 0; null on the others):
+/// its marker written and renamed into place.
 void finish_map(const MapPlan& plan, const MapOutput& output,
-                const std::shared_ptr<const numeric::ValidatedParametricFamily>& family, MapSummary& summary);
+                const std::shared_ptr<const numeric::ValidatedParametricFamily>& family, MapSummary& summary,
+                output::StagedDirectory* stage);
 
 }  // namespace backlash::map::detail

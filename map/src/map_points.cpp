@@ -5,6 +5,7 @@
 #include "map_text.hpp"
 
 #include "backlash/numeric/varied_parameter.hpp"
+#include "backlash/output/text.hpp"
 
 #include <boost/random/sobol.hpp>
 
@@ -23,11 +24,10 @@ const std::string map_names = numeric::varied_parameter_names(", ");
 
 bool known_name(const std::string& v) { return numeric::varied_parameter(v).has_value(); }
 
+// FROM or TO of --vary (output::read_number); a leading '+' is refused, as it always was.
 double parse_number(const std::string& text, const std::string& whole) {
   double value = 0;
-  const char* end = text.data() + text.size();
-  const auto [ptr, error] = std::from_chars(text.data(), end, value);
-  if (text.empty() || error != std::errc() || ptr != end || !std::isfinite(value))
+  if (output::read_number(text, value) != output::NumberText::ok || text.front() == '+')
     throw BadInput("vary", "'" + whole + "': '" + text + "' is not a finite number (expected NAME=FROM:TO:N)");
   return value;
 }

@@ -220,6 +220,39 @@ TEST(MapOutput, exam_resumed_map_is_byte_identical) {
                                                            << " lines instead of 91 (a header and 90 points)";
 }
 
+// --out through the output layer (backlash/output/staged_directory.hpp): refusals are BadInput
+// "out" in the words the map has always used; an earlier map is replaced whole, with the marker
+// "written by backlash map", and nothing is left beside it.
+TEST(MapOutput, check_out_refusals_and_the_replacement_of_an_earlier_map) {
+  auto problem = [](const fs::path& out) -> std::string {
+    api::MapOutput o;
+    o.out = out;
+    try {
+      api::write_map(request({"K=1:2:3"}), o);
+    } catch (const api::BadInput& e) {
+      return e.argument() + ": " + e.problem();
+    }
+    return "(nothing thrown)";
+  };
+  EXPECT_EQ(problem(""), "out: empty path");
+  EXPECT_EQ(problem("/"), "out: /: not a folder name");
+  const fs::path foreign = scratch() / "foreign";
+  fs::create_directories(foreign);
+  std::ofstream(foreign / "keep.txt") << "mine\n";
+  EXPECT_EQ(problem(foreign),
+            "out: " + foreign.string() + ": the folder exists and is not a backlash output; choose a new folder");
+  EXPECT_EQ(slurp(foreign / "keep.txt"), "mine\n") << "a folder that is not a backlash output was touched";
+  api::MapOutput o;
+  o.out = scratch() / "again";
+  ASSERT_TRUE(api::write_map(request({"K=1:2:3"}), o).complete);
+  ASSERT_TRUE(api::write_map(request({"K=1:2:4"}), o).complete);
+  EXPECT_EQ(slurp(o.out / ".backlash-report"), "written by backlash map\n");
+  const std::string csv = slurp(o.out / "points.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5) << "the earlier map was not replaced: " << csv;
+  for (const fs::directory_entry& e : fs::directory_iterator(scratch()))
+    EXPECT_EQ(e.path().filename().string().rfind(".again.", 0), std::string::npos) << e.path() << " was left behind";
+}
+
 TEST(MapBadInput, exam_bad_requests_name_their_argument) {
   auto argument = [](const std::function<void()>& f) -> std::string {
     try {

@@ -156,7 +156,7 @@ class MapTransport {
 };
 
 struct MapOutput {
-  std::filesystem::path out;       ///< the folder (replaced atomically; reports/output_directory.hpp rules)
+  std::filesystem::path out;       ///< the folder (replaced atomically; backlash/output/target.hpp, Target::folder)
   bool resume = false;             ///< continue an interrupted run of the same request
   bool hdf5 = true;                ///< map.h5 beside points.csv
   bool figures = true;             ///< figures/ and summary.md (map/figures.hpp)
