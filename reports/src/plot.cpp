@@ -10,6 +10,8 @@
 #include <iterator>
 #include <sstream>
 
+#include <stdlib.h>  // mkdtemp (POSIX)
+
 namespace backlash::reports {
 
 namespace {
@@ -78,7 +80,23 @@ void preserve_svg_spaces(const std::filesystem::path& file) {
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
+// "%.6g": the value written at a bar's end.
+std::string short_number(double v) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.6g", v);
+  return buffer;
+}
+
 }  // namespace
+
+std::string literal(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (std::string("_^{}@&~\\").find(c) != std::string::npos) out += '\\';
+    out += c;
+  }
+  return out;
+}
 
 bool has_data(const Plot& plot) {
   if (plot.series.empty()) return false;
@@ -114,6 +132,14 @@ void write_data_blocks(std::ostringstream& script, const Plot& plot, std::size_t
     }
     script << "EOD\n";
   }
+  if (plot.bars && !plot.bars->values.empty()) {  // $b<f>: value row 0 value row-0.35 row+0.35 (a NaN: an empty bar)
+    script << "$b" << f << " << EOD\n";
+    for (std::size_t k = 0; k < plot.bars->values.size(); ++k) {
+      const double v = std::isfinite(plot.bars->values[k]) ? plot.bars->values[k] : 0.0, row = static_cast<double>(k);
+      script << number(v) << " " << number(row) << " 0 " << number(v) << " " << number(row - 0.35) << " " << number(row + 0.35) << "\n";
+    }
+    script << "EOD\n";
+  }
   if (!plot.heat_map) return;
   const HeatMap& h = *plot.heat_map;
   script << "$h" << f << " << EOD\n";
@@ -138,6 +164,31 @@ void write_heat_map_settings(std::ostringstream& body, const Plot& plot) {
   if (const auto& r = plot.heat_map->value_range) body << "set cbrange [" << number(r->first) << ":" << number(r->second) << "]\n";
 }
 
+// The settings shades and bars add (none without them: the script of a plain plot is unchanged).
+void write_shade_and_bar_settings(std::ostringstream& body, const Plot& plot) {
+  for (std::size_t k = 0; k < plot.shades.size(); ++k) {
+    const Shade& s = plot.shades[k];
+    body << "set object " << (k + 1) << " rect from " << number(s.x_low) << ", graph 0 to " << number(s.x_high)
+         << ", graph 1 behind fc rgb " << quoted(s.colour, true) << " fs transparent solid " << number(s.opacity) << " noborder\n";
+  }
+  if (!plot.bars) return;
+  const Bars& b = *plot.bars;
+  if (b.values.empty()) {
+    body << "unset ytics\nset yrange [0.6:-0.6]\n";
+    return;
+  }
+  body << "set ytics (";
+  for (std::size_t k = 0; k < b.names.size(); ++k) body << (k ? ", " : "") << quoted(literal(b.names[k])) << " " << k;
+  body << ")\nset grid noytics\n";
+  if (!plot.x_range) body << "set xrange [0:*]\n";
+  if (!plot.y_range) body << "set yrange [" << number(static_cast<double>(b.values.size()) - 0.4) << ":-0.6]\n";
+  for (std::size_t k = 0; k < b.values.size(); ++k) {
+    const double v = b.values[k];
+    body << "set label " << (plot.labels.size() + k + 1) << " " << quoted(std::isfinite(v) ? short_number(v) : "failed")
+         << " at " << number(std::isfinite(v) ? v : 0.0) << "," << k << " offset 0.6,0 font ',10'\n";
+  }
+}
+
 // The gnuplot commands that draw figure f (the same for the SVG and the PDF).
 std::string figure_body(const Plot& plot, std::size_t f) {
   std::ostringstream body;
@@ -147,6 +198,7 @@ std::string figure_body(const Plot& plot, std::size_t f) {
        << "set grid lc rgb '#dddddd'\nset key " << plot.key << " spacing 1.1\n"
        << "set border lw 1\nset tics nomirror\nset xtics mirror\nset ytics mirror\n";
   write_heat_map_settings(body, plot);
+  write_shade_and_bar_settings(body, plot);
   if (plot.x_range) body << "set xrange [" << number(plot.x_range->first) << ":" << number(plot.x_range->second) << "]\n";
   if (plot.y_range) body << "set yrange [" << number(plot.y_range->first) << ":" << number(plot.y_range->second) << "]\n";
   for (std::size_t l = 0; l < plot.labels.size(); ++l)
@@ -155,7 +207,10 @@ std::string figure_body(const Plot& plot, std::size_t f) {
   body << "plot ";
   if (plot.heat_map)
     body << "$h" << f << " using 1:2:3:4:5:6:7 with boxxyerror fs solid 1.0 noborder lc palette notitle"
-         << (plot.series.empty() ? "" : ", \\\n     ");
+         << (plot.series.empty() && !(plot.bars && !plot.bars->values.empty()) ? "" : ", \\\n     ");
+  if (plot.bars && !plot.bars->values.empty())
+    body << "$b" << f << " using 1:2:3:4:5:6 with boxxyerror fs solid 1.0 noborder lc rgb " << quoted(plot.bars->colour, true)
+         << " notitle" << (plot.series.empty() ? "" : ", \\\n     ");
   for (std::size_t i = 0; i < plot.series.size(); ++i) {
     const Series& s = plot.series[i];
     body << (i ? ", \\\n     " : "") << "$d" << f << "_" << i << " using 1:2 with " << s.style
@@ -165,9 +220,9 @@ std::string figure_body(const Plot& plot, std::size_t f) {
   return body.str();
 }
 
-}  // namespace
-
-std::optional<std::string> render_figures(const std::vector<Plot>& plots, const std::filesystem::path& directory) {
+// Runs gnuplot once in `directory` on every plot: figures/NAME.svg, and with `pdf`
+// figures/NAME.pdf (date-fixed).  The script and gnuplot's log are removed.
+std::optional<std::string> run_gnuplot(const std::vector<Plot>& plots, const std::filesystem::path& directory, bool pdf) {
   namespace fs = std::filesystem;
   if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) return std::string("gnuplot is not installed");
   std::ostringstream script;
@@ -180,6 +235,7 @@ std::optional<std::string> render_figures(const std::vector<Plot>& plots, const 
     script << "set terminal svg size " << plot.width << "," << plot.height << " enhanced font 'DejaVu Sans,12' background '#ffffff'\n"
            << "set output " << quoted(stem.string() + ".svg", true) << "\n"
            << body << "set output\n";
+    if (!pdf) continue;
     script << "set terminal pdfcairo size " << number(plot.width / 130.0) << "in," << number(plot.height / 130.0)
            << "in enhanced font 'DejaVu Sans,8.5' background '#ffffff'\n"
            << "set output " << quoted(stem.string() + ".pdf", true) << "\n"
@@ -208,9 +264,34 @@ std::optional<std::string> render_figures(const std::vector<Plot>& plots, const 
   fs::remove(log, ignored);
   if (!failure)
     for (const Plot& plot : plots) {
-      fix_pdf_dates(directory / "figures" / (plot.name + ".pdf"));
+      if (pdf) fix_pdf_dates(directory / "figures" / (plot.name + ".pdf"));
       preserve_svg_spaces(directory / "figures" / (plot.name + ".svg"));
     }
+  return failure;
+}
+
+}  // namespace
+
+std::optional<std::string> render_figures(const std::vector<Plot>& plots, const std::filesystem::path& directory) {
+  return run_gnuplot(plots, directory, true);
+}
+
+std::optional<std::string> render_svgs(const std::vector<Plot>& plots, std::vector<std::string>& svgs) {
+  namespace fs = std::filesystem;
+  svgs.clear();
+  std::error_code error;
+  const fs::path temp = fs::temp_directory_path(error);
+  if (error) return "no temporary folder: " + error.message();
+  std::string folder = (temp / "backlash-plot-XXXXXX").string();
+  if (mkdtemp(folder.data()) == nullptr) return "cannot make a temporary folder in " + temp.string();
+  std::optional<std::string> failure = run_gnuplot(plots, folder, false);
+  for (std::size_t f = 0; !failure && f < plots.size(); ++f) {
+    std::ifstream in(fs::path(folder) / "figures" / (plots[f].name + ".svg"), std::ios::binary);
+    if (!in) failure = "gnuplot drew no " + plots[f].name + ".svg";
+    else svgs.emplace_back((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  }
+  fs::remove_all(folder, error);
+  if (failure) svgs.clear();
   return failure;
 }
 

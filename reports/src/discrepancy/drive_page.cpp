@@ -1,5 +1,5 @@
 // The measured-drive workflow's results as files: JSON, a Markdown page with its figures
-// (deterministic SVG), and the corrected case file.  No timings in the files: the same
+// (SVG drawn by gnuplot through reports/plot.hpp, in memory), and the corrected case file.  No timings in the files: the same
 // record gives the same bytes.
 #include "backlash/reports/discrepancy_pages.hpp"
 
@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 namespace backlash::discrepancy {
@@ -21,7 +22,8 @@ namespace {
 
 
 using detail::Band;
-using detail::Series;
+using detail::Curve;
+using detail::add_figures;
 using detail::bar_chart;
 using detail::line_plot;
 using detail::number;
@@ -176,8 +178,10 @@ std::string drive_corrected_case_file(const model::CaseSpec& spec, const DriveDi
 namespace {
 
 // The figures: the torque residual against velocity, torque and position over the nominal
-// model's worst windows (and the validation record's), the first round's candidates.
-void drive_figures(const DriveDiscrepancyResult& r, std::vector<std::pair<std::string, std::string>>& files) {
+// model's worst windows (and the validation record's), the first round's candidates.  Drawn
+// into `files`; returns the page's note when they could not be drawn.
+std::optional<std::string> drive_figures(const DriveDiscrepancyResult& r, std::vector<std::pair<std::string, std::string>>& files) {
+  std::vector<reports::Plot> figures;
   const bool found = !r.effects.empty();
   // Torque residual against velocity: every sample's dot, and the mean in 60 velocity bins.
   std::vector<double> before(r.t.size()), after(r.t.size());
@@ -187,48 +191,49 @@ void drive_figures(const DriveDiscrepancyResult& r, std::vector<std::pair<std::s
   }
   const auto [vb, mean_before] = binned_mean(r.velocity, before, 60);
   const auto [va, mean_after] = binned_mean(r.velocity, after, 60);
-  std::vector<Series> scatter{{"nominal", "#d77", &r.velocity, &before, false, true},
+  std::vector<Curve> scatter{{"nominal", "#d77", &r.velocity, &before, false, true},
                               {"nominal, mean", "#a11", &vb, &mean_before}};
   if (found) {
     scatter.push_back({"corrected", "#6b8", &r.velocity, &after, false, true});
     scatter.push_back({"corrected, mean", "#175", &va, &mean_after});
   }
-  files.push_back({"torque_residual_vs_velocity.svg",
-                   line_plot("Torque residual (measured drive − model's inverse dynamics) against velocity", "velocity [m/s]",
-                             "force residual [N]", scatter, {}, {{0.0, "zero"}})});
+  figures.push_back(line_plot("torque_residual_vs_velocity",
+                              "Torque residual (measured drive − model's inverse dynamics) against velocity", "velocity [m/s]",
+                              "force residual [N]", scatter, {}, {{0.0, "zero"}}));
   // Torque over time and position over windows: the stretch around the nominal model's worst window.
   const auto range = worst_windows(r.t, r.position, r.position_nominal, r.window_starts, 3);
   const std::vector<double> t = slice(r.t, range), measured = slice(r.torque_measured, range),
                             nominal = slice(r.torque_nominal, range), corrected = slice(r.torque_corrected, range);
-  std::vector<Series> torque{{"measured (filtered)", "#222", &t, &measured},
+  std::vector<Curve> torque{{"measured (filtered)", "#222", &t, &measured},
                              {"nominal needs", "#c33", &t, &nominal, true}};
   if (found) torque.push_back({"corrected needs", "#2a7", &t, &corrected});
-  files.push_back({"torque_over_time.svg", line_plot("Drive torque: measured, and what each model needs along the measured motion",
-                                                     "t [s]", "drive force [N]", torque)});
+  figures.push_back(line_plot("torque_over_time", "Drive torque: measured, and what each model needs along the measured motion",
+                              "t [s]", "drive force [N]", torque));
   const std::vector<double> q = slice(r.position, range), qn = slice(r.position_nominal, range),
                             qc = slice(r.position_corrected, range);
-  std::vector<Series> position{{"measured", "#222", &t, &q}, {"nominal", "#c33", &t, &qn, true}};
+  std::vector<Curve> position{{"measured", "#222", &t, &q}, {"nominal", "#c33", &t, &qn, true}};
   if (found) position.push_back({"corrected", "#2a7", &t, &qc});
   std::vector<Band> windows;
   for (std::size_t w = 0; w < r.window_starts.size(); w += 2)
     windows.push_back({r.window_starts[w], w + 1 < r.window_starts.size() ? r.window_starts[w + 1] : r.t.back(), "#9ab"});
-  files.push_back({"position_window.svg",
-                   line_plot("Position predicted over windows restarted from the measured state (shading: every other window)",
-                             "t [s]", "position [m]", position, windows)});
+  figures.push_back(line_plot("position_window",
+                              "Position predicted over windows restarted from the measured state (shading: every other window)",
+                              "t [s]", "position [m]", position, windows));
   if (r.validation) {
     const auto range_v = worst_windows(r.validation_t, r.validation_position, r.validation_nominal, r.validation_window_starts, 3);
     const std::vector<double> tv = slice(r.validation_t, range_v), qv = slice(r.validation_position, range_v),
                               qvn = slice(r.validation_nominal, range_v), qvc = slice(r.validation_corrected, range_v);
-    std::vector<Series> vp{{"measured", "#222", &tv, &qv}, {"nominal", "#c33", &tv, &qvn, true}};
+    std::vector<Curve> vp{{"measured", "#222", &tv, &qv}, {"nominal", "#c33", &tv, &qvn, true}};
     if (found) vp.push_back({"corrected", "#2a7", &tv, &qvc});
-    files.push_back({"validation_position_window.svg",
-                     line_plot("Validation record (not fitted): position predicted over windows", "t [s]", "position [m]", vp)});
+    figures.push_back(line_plot("validation_position_window", "Validation record (not fitted): position predicted over windows",
+                                "t [s]", "position [m]", vp));
   }
   std::vector<std::pair<std::string, double>> bars;
   if (!r.rounds.empty())
     for (const Candidate& c : r.rounds.front()) bars.push_back({c.effect, c.rms});
-  files.push_back({"candidates.svg", bar_chart("First round: torque RMS with each candidate effect fitted", bars, r.rms_before,
-                                               "best nominal " + number(r.rms_before))});
+  figures.push_back(bar_chart("candidates", "First round: torque RMS with each candidate effect fitted", bars, r.rms_before,
+                              "best nominal " + number(r.rms_before)));
+  return add_figures(figures, files);
 }
 
 // The page's head: status, filter, noise.
@@ -279,7 +284,7 @@ void drive_page_fits(std::ostringstream& md, const DriveDiscrepancyResult& r) {
 }
 
 // The gap before and after, on the estimation and the validation record, with the figures.
-void drive_page_gap(std::ostringstream& md, const std::string& data_name, const std::string& validation_name,
+void drive_page_gap(std::ostringstream& md, const std::string& data_name, const std::string& validation_name, bool drawn,
                     const DriveDiscrepancyResult& r) {
   md << "## The gap\n\n| record | torque RMS, best nominal | torque RMS, corrected | position RMS over " << r.estimation.windows
      << " windows, nominal | position RMS, corrected |\n|---|---|---|---|---|\n";
@@ -290,6 +295,7 @@ void drive_page_gap(std::ostringstream& md, const std::string& data_name, const 
   row(r.estimation, data_name + " (estimation)");
   if (r.validation) row(*r.validation, validation_name + " (validation, not fitted)");
   md << "\nThe model as given in the file: torque RMS " << number(r.rms_given) << ".\n\n";
+  if (!drawn) return;
   md << "![torque residual against velocity](torque_residual_vs_velocity.svg)\n\n![torque over time](torque_over_time.svg)\n\n"
      << "![position over windows](position_window.svg)\n\n";
   if (r.validation) md << "![validation record](validation_position_window.svg)\n\n";
@@ -313,8 +319,8 @@ void drive_page_regions(std::ostringstream& md, const DriveDiscrepancyResult& r)
        << number(g.rms_before) << " | " << number(g.rms_after) << " |\n";
 }
 
-// Every round's candidates.
-void drive_page_candidates(std::ostringstream& md, const DriveDiscrepancyResult& r) {
+// Every round's candidates, and the first round's figure (or why the figures were not drawn).
+void drive_page_candidates(std::ostringstream& md, const DriveDiscrepancyResult& r, const std::optional<std::string>& not_drawn) {
   md << "\n## Candidates\n\nEach effect added to the current model and fitted on seven of ten blocks of the record; ΔBIC with "
         "n_eff = n/τ_int independent residuals; decisive: ΔBIC < −10, the held-out RMS at most 0.8 of the current one, no "
         "parameter at an end of its range.\n\n";
@@ -329,7 +335,7 @@ void drive_page_candidates(std::ostringstream& md, const DriveDiscrepancyResult&
     }
     md << "\n";
   }
-  md << "![candidates](candidates.svg)\n";
+  md << (not_drawn ? *not_drawn : std::string("![candidates](candidates.svg)")) << "\n";
 }
 
 }  // namespace
@@ -338,15 +344,15 @@ std::vector<std::pair<std::string, std::string>> drive_report_files(const model:
                                                                     const std::string& validation_name,
                                                                     const DriveDiscrepancyResult& r) {
   std::vector<std::pair<std::string, std::string>> files;
-  drive_figures(r, files);
+  const std::optional<std::string> not_drawn = drive_figures(r, files);
   files.push_back({"discrepancy.json", drive_to_json(model, r)});
   files.push_back({"corrected.toml", drive_corrected_case_file(model, r)});
   std::ostringstream md;
   drive_page_head(md, model, data_name, r);
   drive_page_fits(md, r);
-  drive_page_gap(md, data_name, validation_name, r);
+  drive_page_gap(md, data_name, validation_name, !not_drawn, r);
   drive_page_regions(md, r);
-  drive_page_candidates(md, r);
+  drive_page_candidates(md, r, not_drawn);
   files.push_back({"discrepancy.md", md.str()});
   return files;
 }

@@ -1,6 +1,6 @@
 // The results of the discrepancy workflow as files: the JSON, a Markdown page and
-// its figures (SVG drawn here, deterministically: the same result gives the same
-// bytes), and the corrected case file.
+// its figures (SVG drawn by gnuplot through reports/plot.hpp, in memory; the same result
+// gives the same bytes), and the corrected case file.
 #include "backlash/reports/discrepancy_pages.hpp"
 
 #include "page_json.hpp"
@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 
 namespace backlash::discrepancy {
@@ -18,9 +19,9 @@ namespace backlash::discrepancy {
 namespace {
 
 using detail::Band;
-using detail::Series;
+using detail::Curve;
+using detail::add_figures;
 using detail::bar_chart;
-using detail::escape_xml;
 using detail::line_plot;
 using detail::number;
 
@@ -89,23 +90,23 @@ std::vector<std::pair<std::string, std::string>> report_files(const model::CaseS
     residual_after[i] = r.theta_measured[i] - r.theta_corrected[i];
   }
   const bool found = !r.effects.empty();
-  std::vector<Series> traces{{"measured", "#222", &r.t, &r.theta_measured}, {"nominal model", "#c33", &r.t, &r.theta_nominal, true}};
+  std::vector<Curve> traces{{"measured", "#222", &r.t, &r.theta_measured}, {"nominal model", "#c33", &r.t, &r.theta_nominal, true}};
   if (found) traces.push_back({"corrected model", "#2a7", &r.t, &r.theta_corrected});
-  files.push_back({"measured_vs_models.svg",
-                   line_plot("Measured θo against the nominal and the corrected model", "t [s]", "θo [rad]", traces)});
+  std::vector<reports::Plot> figures;
+  figures.push_back(line_plot("measured_vs_models", "Measured θo against the nominal and the corrected model", "t [s]", "θo [rad]", traces));
   std::vector<Band> bands;
   for (const Region& g : r.regions)
     if (g.kind == "free") bands.push_back({g.t_start, g.t_end, "#f0a030"});
-  std::vector<Series> residuals{{"nominal", "#c33", &r.t, &residual_before}};
+  std::vector<Curve> residuals{{"nominal", "#c33", &r.t, &residual_before}};
   if (found) residuals.push_back({"corrected", "#2a7", &r.t, &residual_after});
-  files.push_back({"residual.svg", line_plot("Residual θo(measured) − θo(model); shaded: free flight (nominal events)", "t [s]",
-                                             "residual [rad]", residuals, bands,
-                                             {{3 * r.noise, "noise band ±3σ"}, {-3 * r.noise, ""}})});
+  figures.push_back(line_plot("residual", "Residual θo(measured) − θo(model); shaded: free flight (nominal events)", "t [s]",
+                              "residual [rad]", residuals, bands, {{3 * r.noise, "noise band ±3σ"}, {-3 * r.noise, ""}}));
   std::vector<std::pair<std::string, double>> bars;
   if (!r.rounds.empty())
     for (const Candidate& c : r.rounds.front()) bars.push_back({c.effect, c.rms});
-  files.push_back({"candidates.svg", bar_chart("First round: RMS of θo with each candidate effect fitted", bars, r.rms_before,
-                                               "nominal " + number(r.rms_before))});
+  figures.push_back(bar_chart("candidates", "First round: RMS of θo with each candidate effect fitted", bars, r.rms_before,
+                              "nominal " + number(r.rms_before)));
+  const std::optional<std::string> not_drawn = add_figures(figures, files);
   files.push_back({"discrepancy.json", to_json(model, r, step)});
   files.push_back({"corrected.toml", corrected_case_file(model, r, step)});
 
@@ -129,7 +130,7 @@ std::vector<std::pair<std::string, std::string>> report_files(const model::CaseS
            << number(c.delta_bic) << " |\n";
     md << "\nThe corrected model: [corrected.toml](corrected.toml) (it loads and simulates as it is).\n\n";
   }
-  md << "![measured and models](measured_vs_models.svg)\n\n![residual](residual.svg)\n\n";
+  if (!not_drawn) md << "![measured and models](measured_vs_models.svg)\n\n![residual](residual.svg)\n\n";
   md << "## Where they disagree\n\n| from [s] | to [s] | nominal mode | samples | RMS before | RMS after |\n|---|---|---|---|---|---|\n";
   for (const Region& g : r.regions)
     md << "| " << number(g.t_start) << " | " << number(g.t_end) << " | " << g.kind << " | " << g.samples << " | "
@@ -157,7 +158,7 @@ std::vector<std::pair<std::string, std::string>> report_files(const model::CaseS
     }
     md << "\n";
   }
-  md << "![candidates](candidates.svg)\n";
+  md << (not_drawn ? *not_drawn : std::string("![candidates](candidates.svg)")) << "\n";
   files.push_back({"discrepancy.md", md.str()});
   return files;
 }

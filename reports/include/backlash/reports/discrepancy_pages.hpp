@@ -1,9 +1,10 @@
 // backlash/reports/discrepancy_pages.hpp — the discrepancy workflow's results as files
 // (target backlash_discrepancy_pages: no GiNaC).  The workflow (discrepancy/) computes and
 // returns results only; this lays them out: the JSON document of `discrepancy --json`, the
-// Markdown page of `discrepancy --out DIR` with its figures (deterministic SVG: the same
-// result gives the same bytes), and the corrected model as a case file
-// (docs/discrepancy.md, "Output").  No timings in the files.
+// Markdown page of `discrepancy --out DIR` with its figures (SVG drawn by gnuplot through
+// reports/plot.hpp, the project's one plotting route: the same result gives the same
+// bytes; without gnuplot the figures are left out and the page says why), and the
+// corrected model as a case file (docs/discrepancy.md, "Output").  No timings in the files.
 //
 // The functions keep the workflow's namespace (backlash::discrepancy): they are the
 // presentation of its result types.  The facade reaches them through backlash/api/

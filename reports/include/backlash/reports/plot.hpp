@@ -1,15 +1,21 @@
 // backlash/reports/plot.hpp — figures for the reports, drawn by gnuplot.
 //
-// A Plot is a list of series (x, y columns; a NaN breaks a line) with labels,
-// axis titles (with units) and a legend, optionally over a heat map (filled cells
-// coloured by a value, with a colour bar) and on logarithmic axes.  render_figures() writes one gnuplot
-// script with every figure as inline data blocks and runs gnuplot once in the
-// output folder: figures/NAME.svg (for the web pages) and figures/NAME.pdf (vector,
-// for report.pdf; cairo's time stamp is replaced by the epoch, so the bytes are
-// the same from run to run).
+// The one plotting route of the project: the report's figures, the map figures and the
+// discrepancy pages' figures are all Plots drawn by gnuplot.
+//
+// A Plot is a list of series (x, y columns; a NaN breaks a line; lines, dashed lines or
+// points by the series' gnuplot style) with labels, axis titles (with units) and a legend,
+// optionally over a heat map (filled cells coloured by a value, with a colour bar), over
+// shaded stretches of the x axis, with horizontal bars (a bar chart: one named row per
+// bar), and on logarithmic axes.  render_figures() writes one gnuplot script with every
+// figure as inline data blocks and runs gnuplot once in the output folder: figures/NAME.svg
+// (for the web pages) and figures/NAME.pdf (vector, for report.pdf; cairo's time stamp is
+// replaced by the epoch, so the bytes are the same from run to run).  render_svgs() draws
+// the SVGs only and returns them in memory (gnuplot runs in a temporary folder, removed
+// afterwards): for pages that return their files by name (the discrepancy pages).
 // figure_csv() gives each figure's data (series,x,y) so a reader, and the tests,
 // can check what was drawn.  Without gnuplot nothing is drawn and the reason
-// is returned (the report says so instead of failing).
+// is returned: the page or report says so instead of failing.
 #pragma once
 
 #include <filesystem>
@@ -42,6 +48,23 @@ struct HeatMap {
   std::optional<std::pair<double, double>> value_range;  ///< the colour bar's; default: the values'
 };
 
+/// A shaded stretch [x_low, x_high] of the x axis, the full height of the graph, drawn behind
+/// everything (e.g. the free-flight intervals of a residual plot).
+struct Shade {
+  double x_low = 0, x_high = 0;
+  std::string colour = "#f0a030";  ///< "#rrggbb"
+  double opacity = 0.18;           ///< 0 transparent … 1 opaque
+};
+
+/// Horizontal bars from 0 to each value, one row per bar (the first at the top), each row
+/// named on the y axis and its value written at the bar's end ("failed" for a NaN, drawn
+/// as an empty bar).  The x axis starts at 0; draw reference lines as series.
+struct Bars {
+  std::vector<std::string> names;  ///< one per row, shown literally
+  std::vector<double> values;
+  std::string colour = "#4a78b5";
+};
+
 struct Plot {
   std::string name;                ///< file stem under figures/, e.g. "fig21_case_V_phase_plane"
   std::string title;               ///< names the thesis figure
@@ -53,11 +76,23 @@ struct Plot {
   int width = 1000, height = 650;  ///< SVG size in pixels; the PDF is drawn at 130 px per inch
   std::optional<HeatMap> heat_map;  ///< drawn first, under the series
   bool x_log = false, y_log = false;  ///< logarithmic axes
+  std::vector<Shade> shades;          ///< drawn behind everything
+  std::optional<Bars> bars;           ///< a bar chart (rows at y = 0, 1, …; y axis reversed, named)
 };
 
 /// Draws every plot into `directory`/figures (NAME.svg, NAME.pdf).  Returns the reason
 /// when nothing could be drawn (gnuplot missing or failing), else nothing.
 std::optional<std::string> render_figures(const std::vector<Plot>& plots, const std::filesystem::path& directory);
+
+/// Draws every plot as SVG only (the same bytes as render_figures' NAME.svg) and returns them
+/// in memory: `svgs[i]` is plots[i]'s.  gnuplot works in a fresh temporary folder, removed
+/// afterwards.  Returns the reason when nothing could be drawn (gnuplot missing or failing;
+/// `svgs` is then empty), else nothing.  The plots' names must differ.
+std::optional<std::string> render_svgs(const std::vector<Plot>& plots, std::vector<std::string>& svgs);
+
+/// `text` shown literally in gnuplot's enhanced mode (_ ^ { } @ & ~ \ escaped): for names
+/// such as "coulomb_load" in titles, keys and labels.
+std::string literal(const std::string& text);
 
 /// The figure's data as CSV: series,x,y (one row per finite point).
 std::string figure_csv(const Plot& plot);
