@@ -58,15 +58,7 @@ void check_axis(const MapAxis& a, bool grid) {
     throw std::invalid_argument(where + "log scale needs from, to > 0, got " + number(std::min(a.from, a.to)));
 }
 
-// Text shown literally in gnuplot's enhanced mode (_ ^ { } @ & ~ \ escaped).
-std::string literal(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (std::string("_^{}@&~\\").find(c) != std::string::npos) out += '\\';
-    out += c;
-  }
-  return out;
-}
+using reports::literal;  // text shown literally in gnuplot's enhanced mode
 
 // The texts below never put a space right after a sub/superscript: librsvg drops a space
 // at the edge of gnuplot's <tspan> pieces, even a no-break one ("J_{m} + J_{L}" reads "Jm+ JL").
