@@ -112,7 +112,10 @@ struct CaseParameters {
   model::Rational backlash{};              ///< total backlash b >= 0 (faces at ±b/2)
   model::Rational reference{};             ///< θR
   std::optional<model::Rational> step{}, t_end{};  ///< an optional step experiment (t_end > 0)
-  model::Effects effects{};                ///< neutral unless set (docs/effects.md)
+  /// Neutral unless set: one exact member per effect parameter, named by its FIELD in the
+  /// table of effects (model/effect_table.hpp), e.g. effects.coulomb_load = Rational(1, 100);
+  /// a compliant mesh sets mesh_stiffness and mesh_damping (docs/effects.md).
+  model::Effects effects{};
 };
 
 /// A case: exact parameters, optional experiment and effects.  Cheap to copy.
