@@ -8,13 +8,14 @@
 #   - backlash_output links any library of ours (it is the bottom layer), or backlash_model links
 #     any but backlash_output;
 #   - backlash_numeric links the facade, the map, the report layer, discrepancy or GiNaC;
-#   - backlash_api links the report layer (backlash_reports, backlash_plot), the map or GiNaC;
+#   - backlash_api or backlash_api_derive links the report layer (backlash_reports, backlash_plot,
+#     backlash_discrepancy_pages) or the map, or backlash_api GiNaC;
 #   - the map (backlash_map, backlash_map_figures, backlash_map_mpi) links backlash_reports or GiNaC
 #     (backlash_plot, the GiNaC-free gnuplot figures, is allowed);
 #   - backlash_measurements or backlash_discrepancy links GiNaC;
 #   - any other library links GiNaC: GiNaC (PkgConfig::GINAC, backlash_symbolic,
 #     backlash_codegen_lib) is allowed only in symbolic/, codegen/, backlash_api_derive and the
-#     report layer (backlash_reports, and backlash_api_report, the facade's door to it).
+#     report layer (backlash_reports).
 # A rule naming a library the build does not have is skipped (e.g. backlash_map_mpi without MPI).
 cmake_minimum_required(VERSION 3.25)
 if(NOT CLOSURES OR NOT EXISTS "${CLOSURES}/libraries.txt")
@@ -22,9 +23,9 @@ if(NOT CLOSURES OR NOT EXISTS "${CLOSURES}/libraries.txt")
 endif()
 
 set(ginac PkgConfig::GINAC backlash_symbolic backlash_codegen_lib)
-set(reports_layer backlash_reports backlash_plot)
+set(reports_layer backlash_reports backlash_plot backlash_discrepancy_pages)
 set(map_layer backlash_map backlash_map_figures backlash_map_mpi)
-set(ginac_allowed backlash_symbolic backlash_codegen_lib backlash_api_derive backlash_reports backlash_api_report)
+set(ginac_allowed backlash_symbolic backlash_codegen_lib backlash_api_derive backlash_reports)
 
 set(broken 0)
 file(STRINGS "${CLOSURES}/libraries.txt" libraries)
@@ -64,8 +65,10 @@ list(REMOVE_ITEM ours backlash_model)
 forbid(backlash_model "the model sits on the output layer alone: it links no other library of backlash" ${ours})
 forbid(backlash_numeric "numeric is below the facade, the map, the report and discrepancy, and never GiNaC"
   backlash_api backlash_api_derive ${map_layer} ${reports_layer} backlash_discrepancy ${ginac})
-forbid(backlash_api "the facade links neither the report layer nor the map (which is built on it) nor GiNaC"
+forbid(backlash_api "the facade links neither the report layer nor the map (which are built on it) nor GiNaC"
   ${reports_layer} ${map_layer} ${ginac})
+forbid(backlash_api_derive "the GiNaC facade links neither the report layer nor the map (which are built on it)"
+  ${reports_layer} ${map_layer})
 foreach(map_library IN LISTS map_layer)
   forbid(${map_library} "the map may draw with backlash_plot but links neither the report nor GiNaC"
     backlash_reports ${ginac})

@@ -27,7 +27,7 @@
 //      json() / csv() / text() return exactly what the CLI prints for the same request
 //      (docs/design.md: the JSON keys are a contract), final newline included.  A
 //      discrepancy's JSON, page, figures and corrected case file are laid out apart, in
-//      backlash/api/discrepancy_pages.hpp (target backlash::api_pages, also without GiNaC).
+//      backlash/api/discrepancy_pages.hpp (target backlash::discrepancy_pages, also without GiNaC).
 // The exact derivation (GiNaC) is apart, in backlash/api/derive.hpp (target
 // backlash::api_derive), so that a program using this header alone never links GiNaC.
 //

@@ -8,7 +8,7 @@
 //
 // The functions keep the workflow's namespace (backlash::discrepancy): they are the
 // presentation of its result types.  The facade reaches them through backlash/api/
-// discrepancy_pages.hpp (target backlash_api_pages).
+// discrepancy_pages.hpp (the same target).
 #pragma once
 
 #include "backlash/discrepancy/discrepancy.hpp"

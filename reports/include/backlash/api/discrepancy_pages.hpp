@@ -1,9 +1,9 @@
 // backlash/api/discrepancy_pages.hpp — a discrepancy's result (backlash/api/backlash.hpp:
 // api::discrepancy) as files and documents: the JSON of `discrepancy --json`, the page,
-// figures, JSON and corrected case file of `discrepancy --out DIR` (target backlash::api_pages,
-// no GiNaC).  The workflow computes (discrepancy/); the layout is the report layer's
-// GiNaC-free part (reports/discrepancy_pages.hpp), which the numeric facade backlash::api
-// does not link: a program asking for these links backlash::api_pages.
+// figures, JSON and corrected case file of `discrepancy --out DIR` (target
+// backlash::discrepancy_pages, no GiNaC).  The workflow computes (discrepancy/, through the
+// facade); this layout is built on the facade's result, and the facade links nothing of it: a
+// program asking for these links backlash::discrepancy_pages.
 //
 //   const api::Discrepancy found = api::discrepancy(api::load("V"), api::read_record("d.csv"));
 //   std::cout << api::discrepancy_json(found);   // = `backlash discrepancy ... --json`

@@ -1,5 +1,6 @@
-// backlash/api/report.hpp — `backlash report` through the facade (target backlash::api_report,
-// which links the report layer, reports/, and the GiNaC facade, backlash/api/derive.hpp).
+// backlash/api/report.hpp — `backlash report` on the facade (target backlash_reports, the report
+// layer built on the numeric facade and the GiNaC facade, backlash/api/derive.hpp; the facade
+// links nothing of it).
 //
 // The report: for each of the thesis's eight cases a page (Markdown + LaTeX) that reads like
 // the chapter it replaces, the general solutions, the errata ledger, every thesis figure
