@@ -1,4 +1,4 @@
-// report.cpp — `backlash report` through the facade: the report layer (reports/report.hpp)
+// report_request.cpp — api::write_report (backlash/api/report.hpp), `backlash report` on the facade: the report layer (reports/report.hpp)
 // reads its numbers from api::Model and api::sweep, its derivations from api::derive_exact.
 #include "backlash/api/report.hpp"
 

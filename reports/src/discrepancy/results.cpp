@@ -1,4 +1,4 @@
-// discrepancy_pages.cpp — a discrepancy's result laid out by the report layer's GiNaC-free
+// results.cpp — api::discrepancy_json / discrepancy_files (backlash/api/discrepancy_pages.hpp): a discrepancy's result laid out by the report layer's GiNaC-free
 // part (reports/discrepancy_pages.hpp): the step record's pages or the measured drive's.
 #include "backlash/api/discrepancy_pages.hpp"
 
