@@ -188,9 +188,10 @@ RigidDrive rigid_drive_of(const numeric::Parameters& p, const numeric::Effects& 
   constexpr const char* prefix = "rigid_drive_of: ";
   if (p.backlash > 0)
     refuse(prefix, "backlash = ", p.backlash, ": a rigid drive has no gap (the measured-drive simulator needs backlash 0)");
-  if (e.restitution != 0)
-    refuse(prefix, "restitution = ", e.restitution, " needs a gap to close (backlash > 0); a rigid drive has none");
-  if (e.compliant()) refuse(prefix, "compliance (a mesh of stiffness ", e.mesh_stiffness, ") is not a rigid drive");
+  for (const model::EffectInfo& effect : model::effects_table)  // the effects the table says need the gap
+    if (effect.needs_gap && e.has(effect))
+      refuse(prefix, effect.single() ? "" : std::string(effect.key) + ": ", effect.primary().name, " = ",
+             model::field(e, effect.primary().id), " needs a gap to close (backlash > 0); a rigid drive has none");
   RigidDrive m;
   m.J = p.Jm + p.JL;
   m.F = p.Fm + p.FL;
