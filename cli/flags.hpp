@@ -7,7 +7,9 @@
 
 #include "backlash/output/text.hpp"
 
+#include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -66,6 +68,17 @@ inline int parse_whole_int(const std::string& text, const std::string& flag) {
   const long v = parse_whole_number(text, flag);
   const long largest = std::numeric_limits<int>::max();
   return static_cast<int>(v > largest ? largest : v < -largest ? -largest : v);
+}
+
+/// A whole number in 0 … 2^64 − 1 written in decimal digits only (a key, e.g. --seed): no sign,
+/// no exponent, nothing that would wrap or saturate; UsageError naming the flag otherwise.
+inline std::uint64_t parse_unsigned_64(const std::string& text, const std::string& flag) {
+  std::uint64_t value = 0;
+  const char* const end = text.data() + text.size();
+  const auto [ptr, error] = std::from_chars(text.data(), end, value);
+  if (text.empty() || text.front() < '0' || text.front() > '9' || error != std::errc() || ptr != end)
+    throw UsageError(flag + ": '" + text + "' is not a whole number in 0 … 18446744073709551615 (2^64 - 1)");
+  return value;
 }
 
 }  // namespace backlash::cli

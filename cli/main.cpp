@@ -11,13 +11,24 @@
 //      unresolved, work limit): what was computed is printed, the reason is on stderr
 // CLI11's own failure printer uses two lines and exit codes above 100; parse
 // errors are reported here in the one-line form with exit code 2 instead.
+// Here, for every command at once: stdout is checked after the command (a full device, a
+// closed stream: exit 1, "cannot write the output to stdout: …"), an empty --out is refused
+// (exit 2), and SIGINT/SIGTERM/SIGHUP remove the temporaries being written before the process
+// ends by the signal (backlash/output/signals.hpp; `map` stops itself and exits 1).
 #include "commands.hpp"
 
 #include "backlash/api/backlash.hpp"
 #include "backlash/output/output_error.hpp"
+#include "backlash/output/signals.hpp"
 
 #include <CLI/CLI.hpp>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <exception>
 #include <iostream>
 #include <map>
@@ -50,6 +61,35 @@ std::string flag_message(const backlash::api::BadInput& error) {
   return flag == flags.end() ? error.what() : flag->second + ": " + error.problem();
 }
 
+/// A closed stdout or stderr would hand its descriptor to the first file opened, which would
+/// then receive the output: /dev/null opened read-only takes it instead, so that every write to
+/// the stream fails and is reported.
+void guard_standard_streams() {
+  for (const int fd : {STDOUT_FILENO, STDERR_FILENO}) {
+    if (::fcntl(fd, F_GETFD) != -1 || errno != EBADF) continue;
+    const int null = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+    if (null >= 0 && null != fd) ::dup2(null, fd), ::close(null);
+  }
+}
+
+/// Why stdout did not take everything written to it ("" when it did): flushed and checked.
+std::string stdout_failure() {
+  errno = 0;
+  std::cout.flush();
+  const bool failed = std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout;
+  if (!failed) return "";
+  const int error_number = errno;
+  return std::string("cannot write the output to stdout") + (error_number ? ": " + std::string(std::strerror(error_number)) : "");
+}
+
+/// Every command's --out: an empty path is refused (it would otherwise mean "no --out").
+void refuse_empty_out(CLI::App& app) {
+  const CLI::Validator not_empty([](const std::string& value) { return value.empty() ? "empty path; give a name" : ""; },
+                                 "", "not empty");
+  for (CLI::App* command : app.get_subcommands({}))
+    if (CLI::Option* out = command->get_option_no_throw("--out")) out->check(not_empty);
+}
+
 }  // namespace
 
 int main(int argument_count, char** arguments) {
@@ -69,6 +109,9 @@ int main(int argument_count, char** arguments) {
   backlash::cli::register_import_command(app);
   backlash::cli::register_discrepancy_command(app);
   backlash::cli::register_map_command(app);
+  refuse_empty_out(app);
+  guard_standard_streams();
+  backlash::output::clean_up_on_signals();
 
   try {
     app.parse(argument_count, arguments);
@@ -76,6 +119,7 @@ int main(int argument_count, char** arguments) {
     if (parse_error.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(parse_error);
     return report_error(std::string(parse_error.what()) + " (run with --help for usage)", exit_code_for_bad_input);
   } catch (const backlash::cli::StoppedEarly& early) {
+    if (const std::string failure = stdout_failure(); !failure.empty()) return report_error(failure, exit_code_for_failure);
     return report_error(early.what(), exit_code_for_early_stop, "backlash: ");
   } catch (const backlash::cli::UsageError& usage_error) {
     return report_error(usage_error.what(), exit_code_for_bad_input);
@@ -86,5 +130,6 @@ int main(int argument_count, char** arguments) {
   } catch (const std::exception& error) {  // CaseFileError, MeasuredDataError: bad input too
     return report_error(error.what(), backlash::api::is_bad_input(error) ? exit_code_for_bad_input : exit_code_for_failure);
   }
+  if (const std::string failure = stdout_failure(); !failure.empty()) return report_error(failure, exit_code_for_failure);
   return 0;
 }

@@ -6,26 +6,25 @@
 //   mpirun -n N backlash map ... --out DIR      the points split over N ranks, the same files
 //
 // Without --out the points' CSV streams to stdout; with --out DIR the folder gets points.csv,
-// boundary.csv, map.h5, map.json, figures/ and summary.md, atomically.  SIGINT/SIGTERM stop a
-// run at the next block, keeping what is done for --resume.
+// boundary.csv, map.h5, map.json, figures/ and summary.md, atomically.  SIGINT/SIGTERM/SIGHUP
+// stop a run at the next block or boundary point (exit 1), keeping what is done for --resume;
+// a second run onto the same --out is refused while the first lives (exit 2).
 #include "commands.hpp"
+#include "flags.hpp"
 
 #include "backlash/api/map.hpp"
+#include "backlash/output/signals.hpp"
 #ifdef BACKLASH_MPI
 #include "backlash/api/map_mpi.hpp"
 #endif
 
 #include <nlohmann/json.hpp>
 
-#include <csignal>
 #include <iostream>
 
 namespace backlash::cli {
 
 namespace {
-
-volatile std::sig_atomic_t stop_requested = 0;
-extern "C" void request_stop(int) { stop_requested = 1; }
 
 struct MapFlags {
   std::string target, sample = "grid", out;
@@ -33,7 +32,7 @@ struct MapFlags {
   long points = 0, stop_after = -1;
   int threads = 2, block = 32;
   std::optional<double> step;
-  unsigned long long seed = 13;
+  std::string seed = "13";
   bool resume = false, json = false, no_boundary = false, no_hdf5 = false, no_figures = false;
 };
 
@@ -47,7 +46,7 @@ api::MapRequest request_of(const MapFlags& f) {
   r.step = f.step;
   r.block = f.block;
   r.boundary = !f.no_boundary;
-  r.seed = f.seed;
+  r.seed = parse_unsigned_64(f.seed, "--seed");
   return r;
 }
 
@@ -73,12 +72,11 @@ void run(const MapFlags& f) {
   output.figures = !f.no_figures;
   output.stop_after = f.stop_after;
   output.transport = transport.get();
-  output.interrupted = [] { return stop_requested != 0; };
-  std::signal(SIGINT, request_stop);
-  std::signal(SIGTERM, request_stop);
-  const api::MapSummary s = api::write_map(request, output);
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
+  output.interrupted = [] { return output::StopOnSignal::requested(); };
+  const api::MapSummary s = [&] {
+    const output::StopOnSignal stop;  // a signal stops the run cleanly (cli/main.cpp installs the handlers)
+    return api::write_map(request, output);
+  }();
   if (transport && transport->rank() != 0) return;
   const int ranks = transport ? transport->size() : 1;
   if (!s.complete)
@@ -116,7 +114,7 @@ void register_map_command(CLI::App& app) {
   map->add_flag("--no-boundary", flags->no_boundary, "do not solve the cycle/no-cycle boundary");
   map->add_flag("--no-hdf5", flags->no_hdf5, "do not write map.h5");
   map->add_flag("--no-figures", flags->no_figures, "do not draw figures/ and summary.md");
-  map->add_option("--seed", flags->seed, "lhs: the permutations' key (default 13)");
+  map->add_option("--seed", flags->seed, "lhs: the permutations' key, a whole number in 0 … 2^64 - 1 (default 13)");
   map->add_option("--block", flags->block, "points per warm-start block (default 32)")->group("");
   map->add_option("--stop-after", flags->stop_after, "stop after this many points (tests of --resume)")->group("");
   map->callback([flags] {

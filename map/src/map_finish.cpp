@@ -121,9 +121,12 @@ MapBoundaryRow decode_boundary(const std::string& s, std::size_t& at) {
   return b;
 }
 
-// Every rank solves a contiguous share of the crossings on its threads; rank 0 gets them all, in order.
+// Every rank solves a contiguous share of the crossings on its threads; rank 0 gets them all, in
+// order.  `interrupted` is polled before each crossing: a stop on any rank throws Interrupted at
+// rank 0 (the other ranks return what they have; rank 0 writes nothing more).
 std::vector<MapBoundaryRow> solve_all(const MapPlan& plan, std::vector<Crossing> crossings, MapTransport* t,
-                                      const std::shared_ptr<const numeric::ValidatedParametricFamily>& family) {
+                                      const std::shared_ptr<const numeric::ValidatedParametricFamily>& family,
+                                      const std::function<bool()>& interrupted) {
   if (t && t->size() > 1) {
     std::string list(reinterpret_cast<const char*>(crossings.data()), crossings.size() * sizeof(Crossing));
     t->broadcast(list);
@@ -134,22 +137,30 @@ std::vector<MapBoundaryRow> solve_all(const MapPlan& plan, std::vector<Crossing>
   const long begin = n * rank / ranks, end = n * (rank + 1) / ranks;
   std::vector<MapBoundaryRow> mine(static_cast<std::size_t>(end - begin));
   std::atomic<long> next{begin};
+  std::atomic<bool> stopped{false};
   std::vector<std::thread> pool;
   for (int k = 0; k < plan.request().threads; ++k)
     pool.emplace_back([&] {
-      for (long i; (i = next++) < end;) {
+      for (long i; !stopped && (i = next++) < end;) {
+        if (interrupted && interrupted()) stopped = true;
+        if (stopped) break;
         const Crossing& c = crossings[static_cast<std::size_t>(i)];
         mine[static_cast<std::size_t>(i - begin)] =
             solve_boundary(plan, static_cast<int>(c.along), c.lower, c.upper, c.cycle_at_lower != 0, family);
       }
     });
   for (std::thread& thread : pool) thread.join();
-  if (!t || t->size() == 1) return mine;
-  std::string piece;
+  if (!t || t->size() == 1) {
+    if (stopped) throw Interrupted{};
+    return mine;
+  }
+  std::string piece(1, stopped ? 'S' : 'G');
   for (const MapBoundaryRow& b : mine) piece += encode_boundary(b);
   std::vector<MapBoundaryRow> all;
-  for (const std::string& p : t->gather(piece))
-    for (std::size_t at = 0; at < p.size();) all.push_back(decode_boundary(p, at));
+  for (const std::string& p : t->gather(piece)) {
+    if (p.front() == 'S') throw Interrupted{};
+    for (std::size_t at = 1; at < p.size();) all.push_back(decode_boundary(p, at));
+  }
   return all;
 }
 
@@ -184,7 +195,7 @@ void finish_map(const MapPlan& plan, const MapOutput& output,
     crossings = read_points(plan, staging, h5 ? &*h5 : nullptr, figures, boundary);
   }
   std::vector<MapBoundaryRow> rows;
-  if (boundary) rows = solve_all(plan, std::move(crossings), output.transport, family);
+  if (boundary) rows = solve_all(plan, std::move(crossings), output.transport, family, output.interrupted);
   if (!root) return;
   summary.boundary_points = static_cast<long>(rows.size());
   if (boundary) {

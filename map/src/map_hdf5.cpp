@@ -83,6 +83,7 @@ struct MapHdf5::Impl {
 };
 
 MapHdf5::MapHdf5(const std::filesystem::path& path, const MapPlan& plan) : impl_(std::make_unique<Impl>()) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // failures are our one-line errors, not HDF5's stack dumps on stderr
   Impl& m = *impl_;
   m.d = plan.request().vary.size();
   const hid_t creation = checked(H5Pcreate(H5P_FILE_CREATE), "create file properties");

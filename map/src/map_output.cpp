@@ -12,6 +12,7 @@
 #include "backlash/numeric/validated_family.hpp"
 
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <optional>
 #include <sstream>
@@ -114,8 +115,58 @@ bool read_checkpoint(const fs::path& staging, const std::string& print, long& do
   const std::string all = text.str();
   if (all.compare(0, print.size(), print) != 0) return false;
   std::istringstream tail(all.substr(print.size()));
-  std::string a, b, c;
-  return static_cast<bool>(tail >> a >> done >> b >> csv >> c >> bin) && a == "done" && b == "csv" && c == "bin";
+  std::string a, b, c, rest;
+  return static_cast<bool>(tail >> a >> done >> b >> csv >> c >> bin) && a == "done" && b == "csv" && c == "bin" &&
+         !(tail >> rest);
+}
+
+// points.bin against the checkpoint: `done` records numbered 0 … done − 1 in order, in its first `bin` bytes.
+std::string check_records(const fs::path& file, const MapPlan& plan, long done, std::uintmax_t bin) {
+  const std::size_t size = MapRecord::size(plan.request().vary.size());
+  std::error_code error;
+  const std::uintmax_t length = fs::file_size(file, error);
+  if (error) return "points.bin: " + error.message();
+  if (bin != size * static_cast<std::uintmax_t>(done) || length < bin)
+    return "points.bin holds " + std::to_string(length) + " bytes, the checkpoint's " + std::to_string(done) +
+           " points need " + std::to_string(size * static_cast<std::uintmax_t>(done));
+  std::ifstream in(file, std::ios::binary);
+  std::vector<char> record(size);
+  for (long k = 0; k < done; ++k) {
+    std::int64_t index = -1;
+    if (in.read(record.data(), static_cast<std::streamsize>(size))) std::memcpy(&index, record.data(), 8);
+    if (index != k) return "points.bin: record " + std::to_string(k) + " is not point " + std::to_string(k);
+  }
+  return "";
+}
+
+// points.csv against the checkpoint: this request's header, then rows "0,…" to "done − 1,…", in exactly its first `csv` bytes.
+std::string check_rows(const fs::path& file, const MapPlan& plan, long done, std::uintmax_t csv) {
+  std::error_code error;
+  const std::uintmax_t length = fs::file_size(file, error);
+  if (error) return "points.csv: " + error.message();
+  if (length < csv)
+    return "points.csv holds " + std::to_string(length) + " bytes, the checkpoint covers " + std::to_string(csv);
+  std::ifstream in(file, std::ios::binary);
+  std::string line;
+  if (!std::getline(in, line) || in.eof() || line + "\n" != map_csv_header(plan)) return "points.csv has another header";
+  std::uintmax_t read = line.size() + 1;
+  for (long k = 0; k < done; ++k) {
+    if (!std::getline(in, line) || in.eof()) return "points.csv ends before row " + std::to_string(k);
+    if (line.rfind(std::to_string(k) + ",", 0) != 0) return "points.csv: row " + std::to_string(k) + " is not point " + std::to_string(k);
+    read += line.size() + 1;
+  }
+  if (read != csv) return "points.csv: the checkpoint's " + std::to_string(done) + " rows end at byte " +
+                          std::to_string(read) + ", not " + std::to_string(csv);
+  return "";
+}
+
+// The checkpoint against every file it covers ("" when they match, else the reason).
+std::string check_partial(const fs::path& staging, const MapPlan& plan, long done, std::uintmax_t csv,
+                          std::uintmax_t bin) {
+  if (done < 0 || done > plan.count())
+    return "the checkpoint counts " + std::to_string(done) + " points of " + std::to_string(plan.count());
+  const std::string records = check_records(staging / "points.bin", plan, done, bin);
+  return records.empty() ? check_rows(staging / "points.csv", plan, done, csv) : records;
 }
 
 }  // namespace detail
@@ -140,13 +191,13 @@ std::unique_ptr<detail::RowWriter> open_partial(const MapPlan& plan, const MapOu
       throw BadInput("resume", "no interrupted map of this request at " + staging.string() +
                                    " (run without --resume to start it; the case, --vary, --sample, --points, "
                                    "--step and the outputs must be the same)");
+    if (const std::string mismatch = detail::check_partial(staging, plan, done, csv, bin); !mismatch.empty())
+      throw BadInput("resume", "the interrupted map at " + staging.string() + " does not match its checkpoint: " +
+                                   mismatch + "; run without --resume to start over");
   } else {
-    if (fs::exists(staging, error)) {
-      if (!fs::is_directory(staging, error) || (!fs::is_empty(staging, error) && !fs::exists(staging / "checkpoint")))
-        throw BadInput("out", staging.string() + " exists and is not a partial map; remove it");
-      fs::remove_all(staging);
-    }
-    fs::create_directory(staging);
+    if (!fs::is_empty(staging, error) && !fs::exists(staging / "checkpoint"))
+      throw BadInput("out", staging.string() + " exists and is not a partial map; remove it");
+    for (const fs::directory_entry& entry : fs::directory_iterator(staging)) fs::remove_all(entry.path());
   }
   return std::make_unique<detail::RowWriter>(staging, plan, output, print, done, csv, bin);
 }
@@ -238,8 +289,9 @@ MapSummary write_map(const MapRequest& request, const MapOutput& output) {
     complete = compute_distributed(plan, options, *t, summary.resumed_from, writer.get());
   } else {
     try {
-      compute(plan, options, summary.resumed_from, plan.count(),
-              [&](const std::string& record, const std::string& csv) { writer->take(record, csv); });
+      if (summary.resumed_from < plan.count())  // a run stopped in the boundary phase has every point
+        compute(plan, options, summary.resumed_from, plan.count(),
+                [&](const std::string& record, const std::string& csv) { writer->take(record, csv); });
     } catch (const Interrupted&) {
       complete = false;
     }
@@ -247,7 +299,11 @@ MapSummary write_map(const MapRequest& request, const MapOutput& output) {
   if (root) summary.written = writer->written(), summary.kept = writer->done(), writer->close();
   summary.complete = complete;
   if (!complete) return summary;
-  detail::finish_map(plan, output, options.family, summary, stage ? &*stage : nullptr);
+  try {
+    detail::finish_map(plan, output, options.family, summary, stage ? &*stage : nullptr);
+  } catch (const Interrupted&) {  // stopped in the boundary phase: every point kept, the boundary redone on --resume
+    summary.complete = false;
+  }
   return summary;
 }
 

@@ -87,6 +87,8 @@ MapAxis parse_vary(const std::string& text) {
     if (n.empty() || error != std::errc() || ptr != n.data() + n.size() || count < 1 || count > 100000000)
       throw BadInput("vary", "'" + text + "': N must be an integer in 1 … 10^8, got '" + n + "'");
     axis.count = count;
+  } else {
+    axis.count_given = false;
   }
   return axis;
 }
@@ -111,6 +113,9 @@ MapPlan::MapPlan(const MapRequest& request) : request_(request), case_(api::Case
   if (r.sample == "grid") {
     count_ = 1;
     for (const MapAxis& a : r.vary) {
+      if (!a.count_given)
+        throw BadInput("vary", a.name + ": a grid needs the number of values, " + a.name +
+                                   "=FROM:TO:N (FROM:TO alone is for --sample sobol or lhs)");
       if (count_ > (long{1} << 40) / a.count) throw BadInput("vary", "the grid has more than 2^40 points");
       count_ *= a.count;
     }

@@ -3,7 +3,10 @@
 #include "backlash/output/atomic_file.hpp"
 
 #include "backlash/output/output_error.hpp"
+#include "backlash/output/signals.hpp"
 #include "backlash/output/target.hpp"
+
+#include "temporaries.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -41,11 +44,8 @@ mode_t new_file_mode(const fs::path& target) {
 
 AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
   check_target(target_, Target::file);
-  const fs::path folder = target_.parent_path().empty() ? "." : target_.parent_path();
-  std::string name = ".";  // built by appending: GCC 12's -Wrestrict misreads the chained operator+
-  name += target_.filename().string();
-  name += ".tmp-XXXXXX";
-  const std::string pattern = (folder / name).string();
+  remove_stale_temporaries(target_);  // what a killed run onto the same target left (signals.hpp)
+  const std::string pattern = detail::temporary_prefix(target_) + "XXXXXX";
   std::vector<char> buffer(pattern.begin(), pattern.end());
   buffer.push_back('\0');
   fd_ = ::mkostemp(buffer.data(), O_CLOEXEC);
@@ -55,11 +55,14 @@ AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
          "cannot create a file next to " + target_.string() + ": " + system_message(error_number));
   }
   temporary_ = buffer.data();
+  detail::lock_temporary(fd_);
+  tracked_ = detail::track_temporary(temporary_);
 }
 
 AtomicFile::~AtomicFile() {
   if (fd_ >= 0) ::close(fd_);
   if (!committed_ && !temporary_.empty()) ::unlink(temporary_.c_str());
+  detail::forget_temporary(tracked_);
 }
 
 void AtomicFile::write(std::string_view text) {
@@ -87,12 +90,14 @@ void AtomicFile::commit() {
   fd_ = -1;
   if (closed != 0) write_failed(target_, errno);
   check_target(target_, Target::file);  // nothing but a regular file may have appeared there meanwhile
+  const auto held = detail::hold_temporaries();  // a signal's cleanup waits for the rename
   if (::rename(temporary_.c_str(), target_.c_str()) != 0) {
     const int error_number = errno;
     fail(Problem::move_failed, target_, system_message(error_number),
          "cannot move the output into " + target_.string() + ": " + system_message(error_number));
   }
   committed_ = true;
+  detail::forget_temporary(tracked_);
 }
 
 void write_atomically(const fs::path& target, std::string_view content) {
@@ -108,10 +113,16 @@ void OutputFiles::commit(const fs::path& directory) const {
     const fs::path target = directory / relative;
     if (fs::is_directory(target.parent_path(), error)) check_target(target, Target::file);
   }
-  for (const auto& [relative, content] : files_) {
-    const fs::path target = directory / relative;
-    fs::create_directories(target.parent_path());
-    write_atomically(target, content);
+  const bool created = !fs::exists(fs::symlink_status(directory, error));
+  try {
+    for (const auto& [relative, content] : files_) {
+      const fs::path target = directory / relative;
+      fs::create_directories(target.parent_path());
+      write_atomically(target, content);
+    }
+  } catch (...) {
+    if (created) fs::remove_all(directory, error);  // a folder made here (and all in it): nothing stays
+    throw;
   }
 }
 

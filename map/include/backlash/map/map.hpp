@@ -49,11 +49,13 @@
 namespace backlash::map {
 
 /// One varied parameter: --vary NAME=FROM:TO:N (N: grid values; ignored by sobol/lhs, which
-/// take the range only — give N = 1 or any N there).
+/// take the range only — give N = 1 or any N there, or leave it out).  A grid needs N: an axis
+/// without it (count_given false) is refused by MapPlan, never read as one point.
 struct MapAxis {
   std::string name;
   double from = 0, to = 0;
   long count = 1;
+  bool count_given = true;  ///< false: "NAME=FROM:TO" (parse_vary), for sobol/lhs only
 };
 
 /// "JL_over_Jm=0.25:4:40" (or "NAME=FROM:TO" for sampled maps).  api::BadInput "vary" naming the text.

@@ -1,8 +1,9 @@
 // backlash/output/atomic_file.hpp — all-or-nothing output files.
 //
 // A file is written to a uniquely named temporary file next to its target (mkstemp:
-// ".NAME.tmp-XXXXXX", so parallel runs onto one target never collide and the rename stays on
-// one file system), flushed to the disk (fsync) and renamed into place; a failure or a
+// ".NAME.tmp-PID-XXXXXX", so parallel runs onto one target never collide and the rename stays
+// on one file system; removed on SIGINT/SIGTERM and by a later run if its writer was killed:
+// signals.hpp), flushed to the disk (fsync) and renamed into place; a failure or a
 // destruction without commit() removes the temporary file, so nothing half-written is ever
 // left under any name.  The target is checked first and again just before the rename
 // (target.hpp, Target::file): only a regular file is ever replaced.  The new file has the
@@ -11,6 +12,7 @@
 // write_failed when the writing or the rename fails.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -40,6 +42,7 @@ class AtomicFile {
   std::string buffer_;
   int fd_ = -1;
   bool committed_ = false;
+  std::uint64_t tracked_ = 0;  ///< the temporary's ticket for the signal cleanup (signals.hpp)
 };
 
 /// `content` written to `target` through an AtomicFile.
@@ -52,7 +55,8 @@ class OutputFiles {
   void add(const std::filesystem::path& relative, std::string content) { files_[relative] = std::move(content); }
 
   /// Checks the folder and every target first (nothing is written if one is refused), then
-  /// creates the folder if needed and writes the files.
+  /// creates the folder if needed and writes the files.  A failed write removes the folder
+  /// again when this call created it (a full disk leaves no empty folder).
   void commit(const std::filesystem::path& directory) const;
 
  private:

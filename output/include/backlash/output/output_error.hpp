@@ -31,6 +31,7 @@ enum class Problem {
   folder_unreadable,     ///< the target's folder could not be looked at (detail: the system's message)
   not_a_folder,          ///< a folder target that exists and is not a folder
   foreign_folder,        ///< a folder target that is neither empty nor written by the project
+  busy,                  ///< another process is writing the target (its staging folder is locked; detail: that folder)
   create_failed,         ///< the temporary file or folder could not be made (detail: the system's message)
   write_failed,          ///< writing, flushing or closing failed (detail: the system's message)
   move_failed,           ///< the rename into place failed (detail: the system's message)

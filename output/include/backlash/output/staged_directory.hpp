@@ -5,18 +5,24 @@
 // folder into place (an existing output there is moved aside first and removed after, or put
 // back if the move fails).  The target is checked first and again at commit (Target::folder).
 //
-// Two kinds of staging folder:
-//   temporary   ".NAME.tmp-XXXXXX" (mkdtemp, unique): removed when the object is destroyed
-//               without commit() — a failure leaves nothing behind (report, discrepancy).
-//   partial     ".NAME.<tag>" (a fixed name, e.g. ".DIR.map-partial"): kept when destroyed
-//               without commit(), so a later run can find it and go on (`backlash map
-//               --resume`).  The caller decides what it holds and whether it may be reused
-//               (the map's checkpoint); this class only names it and moves it into place.
+// Two kinds of staging folder, each locked (flock on the folder) while its object lives:
+//   temporary   ".NAME.tmp-PID-XXXXXX" (mkdtemp, unique): removed when the object is destroyed
+//               without commit() — a failure leaves nothing behind (report, discrepancy) —
+//               and on SIGINT/SIGTERM/SIGHUP; one left by a killed process (SIGKILL) is
+//               removed by the next StagedDirectory onto the same target (signals.hpp).
+//   partial     ".NAME.<tag>" (a fixed name, e.g. ".DIR.map-partial"): created if absent and
+//               kept when destroyed without commit() (unless this object made it and it is
+//               still empty), so a later run can find it and go on (`backlash map --resume`).
+//               Its lock refuses a second run onto the same target while the first lives
+//               (OutputError bad_target, Problem::busy: exit 2).  The caller decides what it
+//               holds and whether it may be reused (the map's checkpoint); this class only
+//               names, locks and moves it into place.
 // Errors: OutputError (output_error.hpp).
 #pragma once
 
 #include "backlash/output/target.hpp"
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -28,7 +34,8 @@ class StagedDirectory {
   /// A temporary staging folder for `target`; the marker will read "written by backlash <program>".
   explicit StagedDirectory(const std::filesystem::path& target, std::string program = "report",
                            FolderOwner owner = {});
-  /// A partial staging folder ".NAME.<tag>" for `target`: named, not created (see partial_path).
+  /// A partial staging folder ".NAME.<tag>" for `target` (see partial_path): created if absent,
+  /// and locked; OutputError(bad_target, Problem::busy) when another process holds it.
   static StagedDirectory partial(const std::filesystem::path& target, std::string_view tag, std::string program,
                                  FolderOwner owner = {});
   ~StagedDirectory();
@@ -58,6 +65,9 @@ class StagedDirectory {
   FolderOwner owner_;
   bool keep_ = false;  ///< a partial folder: kept when not committed
   bool committed_ = false;
+  bool created_ = false;  ///< a partial folder this object made (removed again while empty)
+  int lock_ = -1;         ///< the staging folder, open and locked (flock) while this object lives
+  std::uint64_t tracked_ = 0;  ///< a temporary folder's ticket for the signal cleanup (signals.hpp)
 };
 
 }  // namespace backlash::output
