@@ -11,7 +11,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <iostream>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -37,6 +40,22 @@ class StoppedEarly : public std::runtime_error {
 inline void print(std::string_view text) {
   if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size())
     throw std::runtime_error("cannot write the output");
+}
+
+/// Why stdout did not take everything written to it ("" when it did): std::cout and stdout
+/// flushed and checked.  main() checks it after every command (exit 1).
+inline std::string stdout_failure() {
+  errno = 0;
+  std::cout.flush();
+  const bool failed = std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout;
+  if (!failed) return "";
+  const int error_number = errno;
+  return std::string("cannot write the output to stdout") + (error_number ? ": " + std::string(std::strerror(error_number)) : "");
+}
+
+/// Flushes stdout before a command goes on to stderr (a summary line): its failure is an error (exit 1).
+inline void flush_stdout() {
+  if (std::string failure = stdout_failure(); !failure.empty()) throw std::runtime_error(failure);
 }
 
 void register_derive_command(CLI::App& app);   // cli/derive_command.cpp

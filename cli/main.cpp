@@ -27,8 +27,6 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <cstdio>
-#include <cstring>
 #include <exception>
 #include <iostream>
 #include <map>
@@ -72,16 +70,6 @@ void guard_standard_streams() {
   }
 }
 
-/// Why stdout did not take everything written to it ("" when it did): flushed and checked.
-std::string stdout_failure() {
-  errno = 0;
-  std::cout.flush();
-  const bool failed = std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout;
-  if (!failed) return "";
-  const int error_number = errno;
-  return std::string("cannot write the output to stdout") + (error_number ? ": " + std::string(std::strerror(error_number)) : "");
-}
-
 /// Every command's --out: an empty path is refused (it would otherwise mean "no --out").
 void refuse_empty_out(CLI::App& app) {
   const CLI::Validator not_empty([](const std::string& value) { return value.empty() ? "empty path; give a name" : ""; },
@@ -119,7 +107,7 @@ int main(int argument_count, char** arguments) {
     if (parse_error.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(parse_error);
     return report_error(std::string(parse_error.what()) + " (run with --help for usage)", exit_code_for_bad_input);
   } catch (const backlash::cli::StoppedEarly& early) {
-    if (const std::string failure = stdout_failure(); !failure.empty()) return report_error(failure, exit_code_for_failure);
+    if (const std::string failure = backlash::cli::stdout_failure(); !failure.empty()) return report_error(failure, exit_code_for_failure);
     return report_error(early.what(), exit_code_for_early_stop, "backlash: ");
   } catch (const backlash::cli::UsageError& usage_error) {
     return report_error(usage_error.what(), exit_code_for_bad_input);
@@ -130,6 +118,6 @@ int main(int argument_count, char** arguments) {
   } catch (const std::exception& error) {  // CaseFileError, MeasuredDataError: bad input too
     return report_error(error.what(), backlash::api::is_bad_input(error) ? exit_code_for_bad_input : exit_code_for_failure);
   }
-  if (const std::string failure = stdout_failure(); !failure.empty()) return report_error(failure, exit_code_for_failure);
+  if (const std::string failure = backlash::cli::stdout_failure(); !failure.empty()) return report_error(failure, exit_code_for_failure);
   return 0;
 }

@@ -37,7 +37,7 @@ void run_simulate(const SimulateOptions& options) {
     run = model.simulate(request);
     print(options.json ? run.json() : run.text());
   }
-  std::fflush(stdout);
+  flush_stdout();
   if (run.stopped_early()) throw StoppedEarly(run.stop_message());
 }
 

@@ -86,7 +86,7 @@ void run_sweep_command(const SweepOptions& o) {
       [&](const numeric::SweepRow& row) { notes.note(row); });
   notes.finish();
   if (file) file->commit();
-  else std::fflush(stdout);
+  else flush_stdout();
   std::fputs(sweep.summary_line().c_str(), stderr);
 }
 
