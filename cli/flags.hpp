@@ -1,16 +1,22 @@
 // backlash/cli/flags.hpp — the numbers of the command line's flags, read strictly: a bad
 // value is a UsageError naming the flag (exit 2).  Whether a value is in range is the
 // facade's to judge (backlash/api/backlash.hpp); its BadInput names the flag (main.cpp).
+// Every numeric flag of every command is read here, from the flag's text: CLI11 is given
+// strings only (its own conversion takes --step 0x10 as 16 and wraps --seed -1).
 #pragma once
 
 #include "commands.hpp"
 
 #include "backlash/output/text.hpp"
 
+#include <cctype>
+#include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 namespace backlash::cli {
@@ -66,6 +72,19 @@ inline int parse_whole_int(const std::string& text, const std::string& flag) {
   const long v = parse_whole_number(text, flag);
   const long largest = std::numeric_limits<int>::max();
   return static_cast<int>(v > largest ? largest : v < -largest ? -largest : v);
+}
+
+/// A key such as a seed: the digits of a whole number from 0 to 2^64 − 1, nothing else (no
+/// sign, exponent or fraction: --seed -1, 1e23 and 18446744073709551616 are refused, not wrapped
+/// or rounded into another key), or UsageError naming the flag.
+inline std::uint64_t parse_key(const std::string& text, const std::string& flag) {
+  std::uint64_t value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || !std::isdigit(static_cast<unsigned char>(text.front())) || end != text.data() + text.size())
+    throw UsageError(flag + ": expected the digits of a whole number from 0 to 18446744073709551615, got '" + text + "'");
+  if (error == std::errc::result_out_of_range)
+    throw UsageError(flag + ": '" + text + "' is too large (at most 18446744073709551615)");
+  return value;
 }
 
 }  // namespace backlash::cli

@@ -9,6 +9,7 @@
 // boundary.csv, map.h5, map.json, figures/ and summary.md, atomically.  SIGINT/SIGTERM stop a
 // run at the next block, keeping what is done for --resume.
 #include "commands.hpp"
+#include "flags.hpp"
 
 #include "backlash/api/map.hpp"
 #ifdef BACKLASH_MPI
@@ -30,10 +31,8 @@ extern "C" void request_stop(int) { stop_requested = 1; }
 struct MapFlags {
   std::string target, sample = "grid", out;
   std::vector<std::string> vary;
-  long points = 0, stop_after = -1;
-  int threads = 2, block = 32;
-  std::optional<double> step;
-  unsigned long long seed = 13;
+  std::string points = "0", stop_after = "-1", threads = "2", block = "32", seed = "13";  // flags.hpp reads them
+  std::optional<std::string> step;
   bool resume = false, json = false, no_boundary = false, no_hdf5 = false, no_figures = false;
 };
 
@@ -42,12 +41,12 @@ api::MapRequest request_of(const MapFlags& f) {
   r.target = f.target;
   for (const std::string& v : f.vary) r.vary.push_back(api::parse_vary(v));
   r.sample = f.sample;
-  r.points = f.points;
-  r.threads = f.threads;
-  r.step = f.step;
-  r.block = f.block;
+  r.points = parse_whole_number(f.points, "--points");
+  r.threads = parse_whole_int(f.threads, "--threads");
+  if (f.step) r.step = parse_number(*f.step, "--step");
+  r.block = parse_whole_int(f.block, "--block");
   r.boundary = !f.no_boundary;
-  r.seed = f.seed;
+  r.seed = parse_key(f.seed, "--seed");
   return r;
 }
 
@@ -71,7 +70,7 @@ void run(const MapFlags& f) {
   output.resume = f.resume;
   output.hdf5 = !f.no_hdf5;
   output.figures = !f.no_figures;
-  output.stop_after = f.stop_after;
+  output.stop_after = parse_whole_number(f.stop_after, "--stop-after");
   output.transport = transport.get();
   output.interrupted = [] { return stop_requested != 0; };
   std::signal(SIGINT, request_stop);
