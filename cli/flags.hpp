@@ -1,18 +1,22 @@
 // backlash/cli/flags.hpp — the numbers of the command line's flags, read strictly: a bad
 // value is a UsageError naming the flag (exit 2).  Whether a value is in range is the
 // facade's to judge (backlash/api/backlash.hpp); its BadInput names the flag (main.cpp).
+// Every numeric flag of every command is read here, from the flag's text: CLI11 is given
+// strings only (its own conversion takes --step 0x10 as 16 and wraps --seed -1).
 #pragma once
 
 #include "commands.hpp"
 
 #include "backlash/output/text.hpp"
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 namespace backlash::cli {
@@ -70,14 +74,16 @@ inline int parse_whole_int(const std::string& text, const std::string& flag) {
   return static_cast<int>(v > largest ? largest : v < -largest ? -largest : v);
 }
 
-/// A whole number in 0 … 2^64 − 1 written in decimal digits only (a key, e.g. --seed): no sign,
-/// no exponent, nothing that would wrap or saturate; UsageError naming the flag otherwise.
-inline std::uint64_t parse_unsigned_64(const std::string& text, const std::string& flag) {
+/// A key such as a seed: the digits of a whole number from 0 to 2^64 − 1, nothing else (no
+/// sign, exponent or fraction: --seed -1, 1e23 and 18446744073709551616 are refused, not wrapped
+/// or rounded into another key), or UsageError naming the flag.
+inline std::uint64_t parse_key(const std::string& text, const std::string& flag) {
   std::uint64_t value = 0;
-  const char* const end = text.data() + text.size();
-  const auto [ptr, error] = std::from_chars(text.data(), end, value);
-  if (text.empty() || text.front() < '0' || text.front() > '9' || error != std::errc() || ptr != end)
-    throw UsageError(flag + ": '" + text + "' is not a whole number in 0 … 18446744073709551615 (2^64 - 1)");
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || !std::isdigit(static_cast<unsigned char>(text.front())) || end != text.data() + text.size())
+    throw UsageError(flag + ": expected the digits of a whole number from 0 to 18446744073709551615, got '" + text + "'");
+  if (error == std::errc::result_out_of_range)
+    throw UsageError(flag + ": '" + text + "' is too large (at most 18446744073709551615)");
   return value;
 }
 

@@ -29,10 +29,8 @@ namespace {
 struct MapFlags {
   std::string target, sample = "grid", out;
   std::vector<std::string> vary;
-  long points = 0, stop_after = -1;
-  int threads = 2, block = 32;
-  std::optional<double> step;
-  std::string seed = "13";
+  std::string points = "0", stop_after = "-1", threads = "2", block = "32", seed = "13";  // flags.hpp reads them
+  std::optional<std::string> step;
   bool resume = false, json = false, no_boundary = false, no_hdf5 = false, no_figures = false;
 };
 
@@ -41,12 +39,12 @@ api::MapRequest request_of(const MapFlags& f) {
   r.target = f.target;
   for (const std::string& v : f.vary) r.vary.push_back(api::parse_vary(v));
   r.sample = f.sample;
-  r.points = f.points;
-  r.threads = f.threads;
-  r.step = f.step;
-  r.block = f.block;
+  r.points = parse_whole_number(f.points, "--points");
+  r.threads = parse_whole_int(f.threads, "--threads");
+  if (f.step) r.step = parse_number(*f.step, "--step");
+  r.block = parse_whole_int(f.block, "--block");
   r.boundary = !f.no_boundary;
-  r.seed = parse_unsigned_64(f.seed, "--seed");
+  r.seed = parse_key(f.seed, "--seed");
   return r;
 }
 
@@ -70,7 +68,7 @@ void run(const MapFlags& f) {
   output.resume = f.resume;
   output.hdf5 = !f.no_hdf5;
   output.figures = !f.no_figures;
-  output.stop_after = f.stop_after;
+  output.stop_after = parse_whole_number(f.stop_after, "--stop-after");
   output.transport = transport.get();
   output.interrupted = [] { return output::StopOnSignal::requested(); };
   const api::MapSummary s = [&] {

@@ -27,7 +27,7 @@ void run_simulate(const SimulateOptions& options) {
   if (options.step) request.step = parse_number(*options.step, "--step");
   if (options.t_end) request.t_end = parse_number(*options.t_end, "--t-end");
   const double dt = parse_number(options.dt, "--dt");
-  if (dt <= 0) throw UsageError("--dt: must be > 0, got " + options.dt);  // also without --csv
+  api::check_sample_interval(dt);  // also without --csv (BadInput "sample_interval": --dt, main.cpp)
   const api::Model model(api::load(options.case_name));
   api::Simulation run;
   if (options.csv) {

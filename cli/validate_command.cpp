@@ -9,6 +9,7 @@
 // formulas of its branches.  With --branches: the parametric and direct
 // evaluators at a representative point of each of the 14 pole-structure branches.
 #include "commands.hpp"
+#include "flags.hpp"
 
 #include "backlash/api/backlash.hpp"
 
@@ -23,13 +24,14 @@ struct ValidateOptions {
   std::string case_name;
   bool json = false;
   bool branches = false;
-  double tolerance = 1e-9;
+  std::string tolerance = "1e-9";
 };
 
 void run_validate(const ValidateOptions& options) {
+  const double tolerance = parse_number(options.tolerance, "--tolerance");
   std::optional<api::Case> source;
   if (!options.case_name.empty()) source = api::load(options.case_name);  // bad input fails before any output
-  const api::Validation validation = api::validate(source, options.branches, options.tolerance);
+  const api::Validation validation = api::validate(source, options.branches, tolerance);
   if (!validation.passed()) throw std::runtime_error(validation.failure_message());
   print(options.json ? validation.json() : validation.text());
 }

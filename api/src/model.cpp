@@ -90,14 +90,25 @@ Model::Model(Case source)
 
 namespace {
 
+/// A sample interval >= 0 (0: events only) giving at most largest_sample_count samples to t_end.
+void check_sampling(double sample_interval, double t_end) {
+  if (!std::isfinite(sample_interval) || sample_interval < 0)
+    throw BadInput("sample_interval", "must be >= 0, got " + detail::number_text(sample_interval));
+  if (sample_interval > 0 && t_end / sample_interval + 1 > largest_sample_count) {
+    std::string problem;
+    appendf(problem, "%g s over t_end = %g s gives %.3g samples; at most %g are recorded (use a larger interval or a "
+                     "shorter t_end)", sample_interval, t_end, std::floor(t_end / sample_interval) + 1, largest_sample_count);
+    throw BadInput("sample_interval", problem);
+  }
+}
+
 /// A simulation's request checked and its options made; the result is still to be computed.
 Simulation prepared(const Model& m, const SimulationRequest& request, numeric::SimulationOptions& options) {
   const model::CaseSpec& spec = m.source().spec();
   Simulation out;
   out.step = requested_step(spec, request.step);
   out.t_end = requested_t_end(spec, request.t_end);
-  if (!std::isfinite(request.sample_interval) || request.sample_interval < 0)
-    throw BadInput("sample_interval", "must be >= 0, got " + detail::number_text(request.sample_interval));
+  check_sampling(request.sample_interval, out.t_end);
   out.case_id = m.id();
   out.parameters = m.evaluator().parameters();
   out.effects = m.effect_model().effects();
@@ -120,9 +131,13 @@ Simulation Model::simulate(const SimulationRequest& request) const {
   return out;
 }
 
+void check_sample_interval(double sample_interval) {
+  if (!std::isfinite(sample_interval) || !(sample_interval > 0))
+    throw BadInput("sample_interval", "must be > 0, got " + detail::number_text(sample_interval));
+}
+
 Simulation Model::simulate_csv(const SimulationRequest& request, const TextSink& csv) const {
-  if (!(request.sample_interval > 0))
-    throw BadInput("sample_interval", "must be > 0, got " + detail::number_text(request.sample_interval));
+  check_sample_interval(request.sample_interval);
   numeric::SimulationOptions options;
   Simulation out = prepared(*this, request, options);
   const char* contact_mode = out.effects.compliant() ? "mesh" : "contact";
@@ -167,8 +182,7 @@ Simulation Model::simulate_from(const FreeFlightStart& start, double t_end, doub
   if (!std::isfinite(start.theta_o)) throw BadInput("theta_o", "not finite, got " + detail::number_text(start.theta_o));
   if (!std::isfinite(start.dtheta_o)) throw BadInput("dtheta_o", "not finite, got " + detail::number_text(start.dtheta_o));
   if (!std::isfinite(t_end) || t_end <= 0) throw BadInput("t_end", "must be > 0, got " + detail::number_text(t_end));
-  if (!std::isfinite(sample_interval) || sample_interval < 0)
-    throw BadInput("sample_interval", "must be >= 0, got " + detail::number_text(sample_interval));
+  check_sampling(sample_interval, t_end);
   Simulation out;
   out.case_id = id();
   out.t_end = t_end;

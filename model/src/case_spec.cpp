@@ -57,7 +57,14 @@ constexpr long largest_decimal_exponent = 4000;
 struct ExactParse {
   std::optional<Rational> value;
   std::string problem;
+  std::size_t significant_digits = 0;  ///< of the mantissa (the larger of a fraction's two)
 };
+
+/// The digits of `digits` from its first to its last nonzero digit (0 for zero).
+std::size_t significant_digit_count(const std::string& digits) {
+  const std::size_t first = digits.find_first_not_of('0');
+  return first == std::string::npos ? 0 : digits.find_last_not_of('0') - first + 1;
+}
 
 ExactParse parse_failure(std::string problem) { return {std::nullopt, std::move(problem)}; }
 
@@ -124,6 +131,8 @@ ExactParse parse_exact_decimal(std::string_view text, bool allow_underscores, bo
     if (exponent_negative) exponent = -exponent;
   }
   if (position != text.size()) return parse_failure("unexpected character '" + std::string(1, text[position]) + "'");
+  const std::size_t significant = significant_digit_count(mantissa_digits);
+  if (significant > largest_significant_digits) return {std::nullopt, "too many digits", significant};
 
   const long scale = exponent - fraction_digit_count;
   if (scale > largest_decimal_exponent || scale < -largest_decimal_exponent)
@@ -132,8 +141,8 @@ ExactParse parse_exact_decimal(std::string_view text, bool allow_underscores, bo
   mantissa_digits.erase(0, std::min(mantissa_digits.find_first_not_of('0'), mantissa_digits.size() - 1));
   cpp_int mantissa(mantissa_digits);
   if (negative) mantissa = -mantissa;
-  if (scale >= 0) return {Rational(mantissa * power_of_ten(scale)), {}};
-  return {Rational(mantissa, power_of_ten(-scale)), {}};
+  if (scale >= 0) return {Rational(mantissa * power_of_ten(scale)), {}, significant};
+  return {Rational(mantissa, power_of_ten(-scale)), {}, significant};
 }
 
 bool names_a_non_finite_number(std::string_view text) {
@@ -149,11 +158,13 @@ ExactParse parse_exact_number_string(std::string_view text) {
   const std::size_t slash = text.find('/');
   if (slash == std::string_view::npos) return parse_exact_decimal(text, false, true);
   ExactParse numerator = parse_exact_decimal(text.substr(0, slash), false, true);
+  if (numerator.problem == "too many digits") return numerator;
   if (!numerator.value) return parse_failure("numerator: " + numerator.problem);
   ExactParse denominator = parse_exact_decimal(text.substr(slash + 1), false, false);
+  if (denominator.problem == "too many digits") return denominator;
   if (!denominator.value) return parse_failure("denominator: " + denominator.problem);
   if (*denominator.value == 0) return parse_failure("division by zero");
-  return {*numerator.value / *denominator.value, {}};
+  return {*numerator.value / *denominator.value, {}, std::max(numerator.significant_digits, denominator.significant_digits)};
 }
 
 // ------------------------------------------------------------------ source text
@@ -553,6 +564,7 @@ class CaseFileReader {
     if (const auto* text = node.as_string()) {
       const ExactParse parsed = parse_exact_number_string(text->get());
       if (parsed.problem == "non-finite") fail(line, key, "non-finite number (got \"" + text->get() + "\")");
+      refuse_too_many_digits(parsed, line, key);
       if (!parsed.value)
         fail(line, key,
              "not a number: \"" + text->get() + "\" (" + parsed.problem +
@@ -560,6 +572,14 @@ class CaseFileReader {
       return {*parsed.value, "\"" + text->get() + "\""};
     }
     fail(line, key, std::string("expected a number, got ") + describe_node_type(node));
+  }
+
+  /// docs/design.md, "Case files": the exact derivation's cost grows with the digits.
+  void refuse_too_many_digits(const ExactParse& parsed, long line, const std::string& key) const {
+    if (parsed.problem != "too many digits") return;
+    fail(line, key,
+         "too many significant digits (" + std::to_string(parsed.significant_digits) + "; at most " +
+             std::to_string(largest_significant_digits) + " are read, a double printed in full has 17)");
   }
 
   /// Reads the float's literal text back from the file and parses it exactly;
@@ -572,6 +592,7 @@ class CaseFileReader {
     while (length < rest.size() && is_float_literal_character(rest[length])) ++length;
     const std::string literal(rest.substr(0, length));
     const ExactParse parsed = parse_exact_decimal(literal, true, true);
+    refuse_too_many_digits(parsed, line_of(node, 1), key);
     // toml++ rounds the literal correctly; so must the exact value of the text we found.
     if (!parsed.value || to_double(*parsed.value) != approximate)
       fail(line_of(node, 1), key,

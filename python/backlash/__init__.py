@@ -10,7 +10,9 @@ Conventions: docs/physics.md, effects: docs/effects.md, contracts: docs/design.m
     v = backlash.load("V")                     # a thesis case I..VIII, or a case file path
     cycle = v.limit_cycle()                    # cycle.peak_to_peak, .period, ... ; cycle.json()
     run = v.simulate(step=0.62, t_end=60)      # run.t, run.theta_o (NumPy), run.events;
-                                               # run.stopped_early, run.stop_reason (no exception)
+                                               # run.stopped_early, run.stop_reason (no exception);
+                                               # dt=0.01: the samples' spacing (> 0, at most 1e7
+                                               # samples; dt=None: events only)
     lines = v.trace([1, 0.5, 0.13])            # dividing lines
     d = v.derive()                             # exact solutions: d.text, d.latex, d.json
     c = backlash.load(name="mine", measured_at="load", Jm="1/2", Fm=0.1, JL=0.5, FL=0.3,

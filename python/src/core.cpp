@@ -122,6 +122,20 @@ py::list events_list(const std::vector<numeric::SimulationEvent>& events) {
   return out;
 }
 
+/// Case.simulate: the step response sampled every `dt` [s] (None: events only, as the CLI's
+/// `simulate` without --csv), through the facade's checks of the CLI's --dt
+/// (api::check_sample_interval, the sample count in Model::simulate), named "dt" here.
+api::Simulation simulate_sampled(const PyCase& c, api::SimulationRequest request, std::optional<double> dt) {
+  try {
+    if (dt) api::check_sample_interval(*dt);
+    request.sample_interval = dt.value_or(0);
+    return c.model().simulate(request);
+  } catch (const api::BadInput& bad) {
+    if (bad.argument() != "sample_interval") throw;
+    throw api::BadInput("dt", bad.problem());
+  }
+}
+
 py::dict candidate_dict(const discrepancy::Candidate& c) {
   py::dict parameters, uncertainty;
   for (const discrepancy::Parameter& p : c.parameters) {
@@ -158,12 +172,8 @@ void bind_cases(py::module_& m) {
       .def("validated", [](const PyCase& c) { (void)c.model(); }, Release())
       .def(
           "simulate",
-          [](const PyCase& c, std::optional<double> step, std::optional<double> t_end, double dt) {
-            api::SimulationRequest request;
-            request.step = step;
-            request.t_end = t_end;
-            request.sample_interval = dt;
-            return c.model().simulate(request);
+          [](const PyCase& c, std::optional<double> step, std::optional<double> t_end, std::optional<double> dt) {
+            return simulate_sampled(c, {.step = step, .t_end = t_end}, dt);
           },
           py::arg("step") = py::none(), py::arg("t_end") = py::none(), py::arg("dt") = 0.01, Release())
       .def(

@@ -1,7 +1,9 @@
 #include "backlash/symbolic/exact.hpp"
 
+#include <cstdint>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 namespace backlash::symbolic {
 
@@ -86,6 +88,34 @@ bool is_exactly_zero(const ex& expression, const RadicalList& radicals) {
   return simplify(expression, radicals).is_zero();
 }
 
+namespace {
+
+/// The primes below 2^16 in packs whose product fits in 63 bits: one big remainder per pack,
+/// then each prime of the pack tested on that remainder in native arithmetic.
+struct PrimePack {
+  std::uint64_t product = 1;
+  std::vector<std::uint64_t> primes;
+};
+
+const std::vector<PrimePack>& trial_primes() {
+  static const std::vector<PrimePack> packs = [] {
+    constexpr std::uint64_t limit = 65536;
+    std::vector<bool> composite(limit + 1, false);
+    std::vector<PrimePack> result(1);
+    for (std::uint64_t p = 2; p <= limit; ++p) {
+      if (composite[p]) continue;
+      for (std::uint64_t q = p * p; q <= limit; q += p) composite[q] = true;
+      if (result.back().product > (std::uint64_t{1} << 63) / p) result.emplace_back();
+      result.back().product *= p;
+      result.back().primes.push_back(p);
+    }
+    return result;
+  }();
+  return packs;
+}
+
+}  // namespace
+
 ex canonical_sqrt(const ex& square) {
   if (!is_a<numeric>(square)) return sqrt(square);
   const numeric value = ex_to<numeric>(square);
@@ -95,13 +125,21 @@ ex canonical_sqrt(const ex& square) {
   // sqrt(p/q) = sqrt(p q)/q; p q = a² r.  Square factors below 2^16 are extracted by trial
   // division and a remaining perfect square exactly (isqrt), so r is square-free for every
   // radicand met in practice and the cost stays bounded for huge ones (FL = 1e-14 gives ~1e30).
-  numeric product = value.numer() * value.denom();
+  // Only primes are tried (a composite's factors are gone by its turn), a pack of them per
+  // big-number remainder: a 17-digit parameter's radicands (~1e70) take microseconds.
   numeric outside = 1;
   numeric inside = 1;
-  numeric remaining = product;
-  for (numeric d = 2; d <= 65536 && d * d <= remaining; d = d + 1) {
-    while (irem(remaining, d * d).is_zero()) { remaining = remaining / (d * d); outside = outside * d; }
-    if (irem(remaining, d).is_zero()) { remaining = remaining / d; inside = inside * d; }
+  numeric remaining = value.numer() * value.denom();
+  for (const PrimePack& pack : trial_primes()) {
+    const std::uint64_t first = pack.primes.front();
+    if (numeric(static_cast<long>(first * first)) > remaining) break;
+    const auto residue = static_cast<std::uint64_t>(irem(remaining, numeric(static_cast<long>(pack.product))).to_long());
+    for (const std::uint64_t prime : pack.primes) {
+      if (residue % prime != 0) continue;
+      const numeric d(static_cast<long>(prime));
+      while (irem(remaining, d * d).is_zero()) { remaining = remaining / (d * d); outside = outside * d; }
+      if (irem(remaining, d).is_zero()) { remaining = remaining / d; inside = inside * d; }
+    }
   }
   if (const numeric root = isqrt(remaining); root * root == remaining) {
     outside = outside * root;

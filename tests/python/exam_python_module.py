@@ -138,7 +138,7 @@ def test_early_stop_is_a_status_with_its_reason(tmp_path):
     from known import CLI
     grows = backlash.load(name="grows", measured_at="load", Jm="1/2", Fm=0, JL="1/2", FL=0, K=1, backlash="3/10",
                           reference=1)
-    run = grows.simulate(step=0.62, t_end=2e5, dt=0)
+    run = grows.simulate(step=0.62, t_end=2e5, dt=None)
     assert run.stopped_early, f"simulate() returned status {run.status} instead of an early stop"
     expect_equal("simulate().status", run.status, "event_limit")
     assert "event cap" in run.stop_reason, run.stop_reason

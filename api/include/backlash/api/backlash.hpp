@@ -199,6 +199,15 @@ struct SimulationRequest {
   double sample_interval = 0;     ///< > 0: record the trajectory every this many seconds (csv())
 };
 
+/// The most samples one simulation records or streams (t_end/sample_interval + 1): ten
+/// million, 640 MB held in memory or about 1.3 GB of CSV text (docs/design.md, "Command line").
+inline constexpr double largest_sample_count = 1e7;
+
+/// A sampled trajectory's spacing [s] — the CLI's --dt, Python's dt — checked before any
+/// work: BadInput "sample_interval" unless finite and > 0.  The simulations also refuse,
+/// with the end time known, more than largest_sample_count samples (BadInput "sample_interval").
+void check_sample_interval(double sample_interval);
+
 /// A start in free flight just after a separation (the thesis's "second inputs", a point of
 /// a limit cycle on the separation line): both shafts at θ̇o [rad/s], the measured one at
 /// θo [rad], the gap at the face just left — face −1: θL − θm = −b/2 (the motor was pushing
@@ -262,7 +271,8 @@ class Model {
 
   /// The step response.  BadInput "step" (none given and the case has no step
   /// experiment, or a step too large for double precision to resolve the backlash against,
-  /// numeric/scales.hpp), "t_end" (<= 0), "sample_interval" (< 0).
+  /// numeric/scales.hpp), "t_end" (<= 0), "sample_interval" (< 0, or more than
+  /// largest_sample_count samples).
   Simulation simulate(const SimulationRequest& request = {}) const;
   /// The same, its CSV (Simulation::csv(), byte for byte) handed to `csv` as it is computed:
   /// the header, each sample, the early-stop line.  sample_interval must be > 0.

@@ -76,6 +76,12 @@ struct CaseSpec {
 /// The names [fit] free accepts, in this order.
 const std::vector<std::string>& fittable_parameters();
 
+/// The most significant digits a number of a case file may have (a decimal's, from its first
+/// to its last nonzero digit; each of a fraction's numerator and denominator): 17 print a
+/// double in full, and the exact derivation's cost grows with the digits (docs/design.md,
+/// "Case files").  More is refused at the number's line.
+inline constexpr std::size_t largest_significant_digits = 100;
+
 /// A bad case file. what() is one line: "FILE:LINE: KEY: problem".
 class CaseFileError : public std::runtime_error {
  public:
@@ -99,7 +105,7 @@ class CaseFileError : public std::runtime_error {
 /// stiffness <= 0, a negative damping or delay, an unknown effect, and the pair
 /// restitution + compliance (both would model the impact) → CaseFileError.
 /// Decimals as written become exact rationals (0.3 → 3/10); strings "p/q" and
-/// integers are accepted.
+/// integers are accepted, each with at most largest_significant_digits significant digits.
 CaseSpec load_case_file(const std::filesystem::path& file);
 
 /// The same strict reader on a case file's text already in memory; `file` names it in
