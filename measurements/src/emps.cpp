@@ -276,8 +276,8 @@ void require_whole_v5_elements(const std::filesystem::path& file) {
     }
     if (bytes > size - at - 8)
       throw MeasuredDataError(file, 0, "",
-                              fmt::format("truncated: data element {} (at byte {}) declares {} bytes, the file ends "
-                                          "{} bytes short of it",
+                              fmt::format("cannot read: the file is truncated or corrupt (data element {} at byte {} "
+                                          "declares {} bytes, the file ends {} bytes short of it)",
                                           element, at, bytes, bytes - (size - at - 8)));
     at += 8 + bytes;
   }
