@@ -6,6 +6,7 @@
 // record (EMPS) is read as `backlash import` would convert it.
 #include "commands.hpp"
 #include "flags.hpp"
+#include "progress.hpp"
 
 #include "backlash/api/backlash.hpp"
 #include "backlash/api/discrepancy_pages.hpp"
@@ -25,6 +26,7 @@ struct DiscrepancyOptions {
   std::optional<std::string> step, validate, cutoff, window;
   std::string threads = "2";
   bool json = false;
+  bool no_progress = false;
 };
 
 api::DiscrepancyRequest request_of(const DiscrepancyOptions& o) {
@@ -33,6 +35,7 @@ api::DiscrepancyRequest request_of(const DiscrepancyOptions& o) {
   if (o.cutoff) request.cutoff = parse_number(*o.cutoff, "--cutoff");
   if (o.window) request.window = parse_number(*o.window, "--window");
   request.threads = parse_whole_int(o.threads, "--threads");
+  request.progress = progress_bar(o.no_progress);
   return request;
 }
 
@@ -72,6 +75,7 @@ void register_discrepancy_command(CLI::App& app) {
   command->add_option("--cutoff", options->cutoff, "measured drive: the low-pass cut-off [Hz] (default: from the position's spectrum)");
   command->add_option("--window", options->window, "measured drive: position-prediction windows [s] (default 0.5)");
   command->add_flag("--json", options->json, "print one JSON document");
+  command->add_flag("--no-progress", options->no_progress, "no progress bar (step records: one bar per round of candidates, on a terminal)");
   command->callback([options] { run_discrepancy(*options); });
 }
 

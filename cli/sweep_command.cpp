@@ -12,6 +12,7 @@
 // stderr when it is a terminal (--no-progress turns it off).
 #include "commands.hpp"
 #include "flags.hpp"
+#include "progress.hpp"
 
 #include "backlash/api/backlash.hpp"
 #include "backlash/output/atomic_file.hpp"
@@ -33,14 +34,6 @@ struct SweepOptions {
   std::string out;
   bool no_progress = false;
 };
-
-/// The progress bar on stderr: "[#####     ]  50% (done/total)".
-void draw_progress(long done, long total) {
-  const int width = 40, filled = static_cast<int>(width * done / total);
-  std::fprintf(stderr, "\r[%s%s] %3ld%% (%ld/%ld)", std::string(filled, '#').c_str(),
-               std::string(width - filled, ' ').c_str(), 100 * done / total, done, total);
-  if (done == total) std::fprintf(stderr, "\n");
-}
 
 /// Why a row has no cycle: the first few reasons on stderr (one line each), then a count.
 class NoCycleNotes {
@@ -71,7 +64,7 @@ api::SweepRequest request_of(const SweepOptions& o) {
   if (!o.to.empty()) request.to = parse_number(o.to, "--to");
   request.points = parse_whole_number(o.points, "--points");
   request.threads = parse_whole_int(o.threads, "--threads");
-  if (!o.no_progress && isatty(STDERR_FILENO)) request.progress = draw_progress;
+  request.progress = progress_bar(o.no_progress);
   return request;
 }
 

@@ -62,6 +62,8 @@ discrepancy::Status Discrepancy::status() const { return step_ ? step_->status :
 
 Discrepancy discrepancy(const Case& model, const measurements::MeasuredRecord& data, const DiscrepancyRequest& request) {
   const model::CaseSpec& spec = model.spec();
+  measurements::require_computable(data);  // a sample beyond 1e100 is bad input, named by its line
+  if (request.validation) measurements::require_computable(*request.validation);
   Discrepancy out;
   out.model_ = spec;
   if (spec.experiment && spec.experiment->kind == model::ExperimentKind::Drive) {
@@ -104,6 +106,7 @@ Discrepancy discrepancy(const Case& model, const measurements::MeasuredRecord& d
     throw BadInput("threads", "expected an integer from 1 to 256, got " + std::to_string(request.threads));
   discrepancy::DiscrepancyOptions options;
   options.threads = request.threads;
+  options.progress = request.progress;
   out.step_value_ = step;
   try {
     out.step_ = discrepancy::find_discrepancy(spec, data, step, options);

@@ -22,7 +22,8 @@ namespace backlash::discrepancy::detail {
 
 // ------------------------------------------------------------------ Simulator
 
-Simulator::Simulator(const Observations& data, double step, double t_end) : data_(data), step_(step), t_end_(t_end) {}
+Simulator::Simulator(const Observations& data, double step, double t_end, double step_time)
+    : data_(data), step_(step), t_end_(t_end), step_time_(step_time) {}
 
 void Simulator::prepare(const std::vector<ModelPoint>& points) {
   std::vector<std::pair<numeric::Parameters, numeric::Effects>> samples;
@@ -41,8 +42,20 @@ std::optional<std::vector<std::vector<double>>> Simulator::traces(const ModelPoi
   numeric::SimulationOptions o;
   samples = std::min(samples, data_.size());
   o.sample_times.assign(data_.t.begin(), data_.t.begin() + static_cast<std::ptrdiff_t>(samples));
-  o.t_end = std::min(t_end_, o.sample_times.back()) + 1e-9;
+  for (double& time : o.sample_times) time -= step_time_;  // the model's clock starts at the step
+  o.t_end = std::min(t_end_ - step_time_, o.sample_times.back()) + 1e-9;
   o.max_events = 20000;  // a fit's trial point that needs more (a stiff, barely damped mesh) is a failed point
+  // The samples go straight into the traces (no list of full trajectory samples: on a long
+  // record that list was most of the workflow's memory, per worker thread).
+  std::vector<std::vector<double>> out(data_.which.size(), std::vector<double>(samples));
+  std::size_t filled = 0;
+  auto keep = [&](const numeric::TrajectorySample& s) {
+    if (filled < samples)
+      for (std::size_t c = 0; c < data_.which.size(); ++c)
+        out[c][filled] = data_.which[c] == 0 ? s.theta_o : data_.which[c] == 1 ? s.theta_m : s.theta_L;
+    ++filled;
+  };
+  o.sample_sink = keep;
   ++simulations_;
   numeric::SimulationResult r;
   try {
@@ -51,16 +64,14 @@ std::optional<std::vector<std::vector<double>>> Simulator::traces(const ModelPoi
     if (std::getenv("BACKLASH_DEBUG_FITS")) std::fprintf(stderr, "discrepancy: simulation failed (%s): %s\n", m.e.describe().c_str(), error.what());
     return std::nullopt;
   }
+  for (const numeric::TrajectorySample& s : r.samples) keep(s);  // a simulator that kept its samples
   if (r.status == numeric::SimulationStatus::NonFinite || r.status == numeric::SimulationStatus::EventLimit ||
-      r.status == numeric::SimulationStatus::Chattering || r.samples.size() != samples)
+      r.status == numeric::SimulationStatus::Chattering || filled != samples)
     return std::nullopt;
-  std::vector<std::vector<double>> out(data_.which.size(), std::vector<double>(samples));
-  for (std::size_t c = 0; c < data_.which.size(); ++c)
-    for (std::size_t i = 0; i < samples; ++i) {
-      const numeric::TrajectorySample& s = r.samples[i];
-      out[c][i] = data_.which[c] == 0 ? s.theta_o : data_.which[c] == 1 ? s.theta_m : s.theta_L;
-    }
-  if (events) *events = r.events;
+  if (events) {
+    *events = r.events;
+    for (numeric::SimulationEvent& event : *events) event.t += step_time_;  // on the record's clock
+  }
   return out;
 }
 

@@ -59,7 +59,10 @@ struct Observations {
 /// Simulations of model points on the record's grid, through a validated family.
 class Simulator {
  public:
-  Simulator(const Observations& data, double step, double t_end);
+  /// `step_time`: the step's time on the record's clock ([experiment] step_time): the model,
+  /// which starts with its step at 0, is sampled at t − step_time, its events reported at
+  /// their time + step_time.
+  Simulator(const Observations& data, double step, double t_end, double step_time = 0);
   /// θ at the record's times for each observed column; nothing if the model is outside the
   /// validated family or the simulation did not end in a normal status.
   std::optional<std::vector<std::vector<double>>> traces(const ModelPoint& m, std::size_t samples,
@@ -70,7 +73,7 @@ class Simulator {
 
  private:
   const Observations& data_;
-  double step_, t_end_;
+  double step_, t_end_, step_time_;
   numeric::ValidatedModelFamily family_;
   std::atomic<int> simulations_{0};
 };

@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <atomic>
+#include <charconv>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <numeric>
 #include <stdexcept>
 #include <thread>
@@ -161,6 +163,13 @@ std::vector<Trial> round_of(Simulator& simulator, const Observations& o, const M
                             double step, const DiscrepancyOptions& options) {
   std::vector<Trial> trials(effects.size());
   std::atomic<std::size_t> next{0};
+  std::mutex progress_mutex;
+  long finished = 0;
+  auto report = [&] {
+    if (!options.progress) return;
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    options.progress(++finished, static_cast<long>(trials.size()));
+  };
   auto work = [&] {
     for (std::size_t i = next++; i < trials.size(); i = next++) {
       const auto started = std::chrono::steady_clock::now();
@@ -205,6 +214,7 @@ std::vector<Trial> round_of(Simulator& simulator, const Observations& o, const M
       }
       if (!t.fit.ok) t.result.bic = t.result.rms = t.result.rms_holdout = INFINITY;
       t.result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      report();
     }
   };
   std::vector<std::thread> pool;
@@ -306,17 +316,65 @@ double first_departure(const Observations& o, const std::vector<double>& model) 
   return NAN;
 }
 
+/// The shortest decimal that reads back as `value` (for messages).
+std::string shortest_text(double value) {
+  char buffer[32];
+  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return error == std::errc() ? std::string(buffer, end) : "?";
+}
+
+/// A step record is sampled: no interval longer than `largest_gap_intervals` median intervals
+/// (a gap the record does not see is motion the model would have to be simulated through
+/// unobserved, and the event cap of a long simulation is not a statement about the data).
+void require_sampled(const measurements::MeasuredRecord& data) {
+  constexpr double largest_gap_intervals = 100;
+  std::vector<double> intervals(data.size() - 1);
+  for (std::size_t i = 1; i < data.size(); ++i) intervals[i - 1] = data.t[i] - data.t[i - 1];
+  std::vector<double> sorted = intervals;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  for (std::size_t i = 0; i < intervals.size(); ++i)
+    if (intervals[i] > largest_gap_intervals * median)
+      throw measurements::sample_error(
+          data, i + 1, "t",
+          "a gap of " + shortest_text(intervals[i]) + " s after t = " + shortest_text(data.t[i]) +
+              " s, more than 100 times the median sample interval " + shortest_text(median) +
+              " s: a step record is sampled without gaps (docs/discrepancy.md)");
+}
+
+/// The step's time on the record's clock ([experiment] step_time, absent: 0), checked against
+/// the record (at least 10 samples, no gap: require_sampled): it must start at most one
+/// sample interval after the step (it sees the response from its start) and end after it.
+double checked_step_time(const model::CaseSpec& spec, const measurements::MeasuredRecord& data) {
+  if (data.size() < 10) throw std::invalid_argument("the record has fewer than 10 samples");
+  require_sampled(data);
+  const double step_time =
+      spec.experiment && spec.experiment->step_time ? model::to_double(*spec.experiment->step_time) : 0.0;
+  const double first = data.t.front(), interval = data.t[1] - data.t[0];
+  const std::string where = "the step at t = " + shortest_text(step_time) + " s ([experiment] step_time" +
+                            (spec.experiment && spec.experiment->step_time ? "" : ", absent: 0") + ")";
+  if (first - step_time > interval)
+    throw measurements::sample_error(data, 0, "t",
+                                     "the record starts at t = " + shortest_text(first) + " s, after " + where +
+                                         ": it does not cover the step (give the step's time as [experiment] step_time)");
+  if (!(data.t.back() > step_time))
+    throw measurements::sample_error(data, data.size() - 1, "t",
+                                     "the record ends at t = " + shortest_text(data.t.back()) + " s, before " +
+                                         where + ": it does not cover the step");
+  return step_time;
+}
+
 }  // namespace
 
 DiscrepancyResult find_discrepancy(const model::CaseSpec& spec, const measurements::MeasuredRecord& data, double step,
                                    const DiscrepancyOptions& options) {
   const auto started = std::chrono::steady_clock::now();
   if (step == 0) throw std::invalid_argument("the step is 0: there is no experiment to compare with");
-  if (data.size() < 10) throw std::invalid_argument("the record has fewer than 10 samples");
+  const double step_time = checked_step_time(spec, data);
   DiscrepancyResult result;
   const Observations o = observations_of(data, options.holdout_fraction, step);
   ModelPoint nominal{numeric::parameters_of(spec), numeric::effects_of(spec)};
-  Simulator simulator(o, step, data.t.back());
+  Simulator simulator(o, step, data.t.back(), step_time);
   simulator.prepare({nominal});
   std::vector<numeric::SimulationEvent> nominal_events;
   const auto nominal_traces = simulator.traces(nominal, o.size(), &nominal_events);

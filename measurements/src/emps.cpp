@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <fstream>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -242,6 +243,46 @@ class EmpsReader {
   std::filesystem::path file_;
 };
 
+// ------------------------------------------------------------------ the v5 file's extent
+
+std::uint32_t read_u32(const unsigned char* bytes, bool swapped) {
+  const std::uint32_t value = static_cast<std::uint32_t>(bytes[0]) | static_cast<std::uint32_t>(bytes[1]) << 8 |
+                              static_cast<std::uint32_t>(bytes[2]) << 16 | static_cast<std::uint32_t>(bytes[3]) << 24;
+  return swapped ? __builtin_bswap32(value) : value;
+}
+
+/// A MATLAB v5 file is a 128-byte header and a sequence of data elements, each an 8-byte tag
+/// (type, byte count) and that many bytes (a compressed variable is one element).  matio reads
+/// a variable cut short by the end of the file as zeros (a truncated zlib stream inflates
+/// without complaint), so every element's extent is checked against the file first: an
+/// element reaching past the end is a truncated file, refused.
+void require_whole_v5_elements(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  in.seekg(0, std::ios::end);
+  const auto size = static_cast<std::uint64_t>(std::max<std::streamoff>(0, in.tellg()));
+  unsigned char header[128];
+  in.seekg(0);
+  if (size < 128 || !in.read(reinterpret_cast<char*>(header), 128)) return;  // matio has refused such a file already
+  const bool swapped = header[126] == 'M' && header[127] == 'I';
+  std::uint64_t at = 128;
+  for (int element = 1; at + 8 <= size; ++element) {
+    unsigned char tag[8];
+    in.seekg(static_cast<std::streamoff>(at));
+    if (!in.read(reinterpret_cast<char*>(tag), 8)) break;
+    const std::uint32_t type = read_u32(tag, swapped), bytes = read_u32(tag + 4, swapped);
+    if ((type >> 16) != 0) {  // the small-element form: type and up to 4 bytes in the tag itself
+      at += 8;
+      continue;
+    }
+    if (bytes > size - at - 8)
+      throw MeasuredDataError(file, 0, "",
+                              fmt::format("cannot read: the file is truncated or corrupt (data element {} at byte {} "
+                                          "declares {} bytes, the file ends {} bytes short of it)",
+                                          element, at, bytes, bytes - (size - at - 8)));
+    at += 8 + bytes;
+  }
+}
+
 }  // namespace
 
 EmpsRecord read_emps(const std::filesystem::path& file, std::uintmax_t max_file_bytes) {
@@ -254,6 +295,7 @@ EmpsRecord read_emps(const std::filesystem::path& file, std::uintmax_t max_file_
   const mat_ft version = Mat_GetVersion(mat.get());
   if (version != MAT_FT_MAT5 && version != MAT_FT_MAT73)
     throw MeasuredDataError(file, 0, "", "not a MATLAB v5 or v7.3 .mat file (EMPS records are v5)");
+  if (version == MAT_FT_MAT5) require_whole_v5_elements(file);
   return EmpsReader(mat.get(), file).read();
 }
 

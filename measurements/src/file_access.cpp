@@ -133,6 +133,11 @@ void write_file_atomically(const std::filesystem::path& target, std::string_view
   try {
     output::write_atomically(target, content);
   } catch (const output::OutputError& error) {
+    // A failed write (a full disk, a permission) is no bad input: it stays an OutputError of its
+    // kind (exit 1), worded as this library words it; a bad target is bad input (exit 2).
+    if (error.kind() == output::OutputError::Kind::write_failed)
+      throw output::OutputError(error.kind(), error.problem(), target, error.detail(),
+                                target.string() + ": " + write_problem(error));
     fail(target, write_problem(error));
   }
 }

@@ -19,8 +19,10 @@ void require_readable_regular_file(const std::filesystem::path& file, std::uintm
 std::string read_regular_file(const std::filesystem::path& file, std::uintmax_t max_bytes);
 
 /// Writes `content` to `target` all at once (backlash/output/atomic_file.hpp: a unique
-/// temporary sibling, fsync'ed and renamed into place); its refusals and failures as
-/// MeasuredDataError(target, 0, "", "cannot write: …" or "refusing to replace it: …").
+/// temporary sibling, fsync'ed and renamed into place); its refusals (a bad target) as
+/// MeasuredDataError(target, 0, "", "cannot write: …" or "refusing to replace it: …"), its
+/// failures (a full disk, a permission) as output::OutputError of kind write_failed whose
+/// what() is "TARGET: cannot write: …".
 void write_file_atomically(const std::filesystem::path& target, std::string_view content);
 
 /// Text made safe for a one-line message: control and non-ASCII bytes, quote

@@ -346,4 +346,20 @@ void write_measured_csv(const MeasuredRecord& record, const std::filesystem::pat
   detail::write_file_atomically(target, format_measured_csv(record));
 }
 
+MeasuredDataError sample_error(const MeasuredRecord& record, std::size_t index, const std::string& column,
+                               const std::string& problem) {
+  if (record.source.extension() == ".mat")
+    return MeasuredDataError(record.source, 0, column, fmt::format("sample {}: {}", index + 1, problem));
+  return MeasuredDataError(record.source, static_cast<long>(index) + 2, column, problem);
+}
+
+void require_computable(const MeasuredRecord& record) {
+  for (const auto& [name, values] : present_columns(record))
+    for (std::size_t index = 0; index < values->size(); ++index)
+      if (!(std::fabs((*values)[index]) <= largest_computable_sample))
+        throw sample_error(record, index, std::string(name),
+                           fmt::format("{} is larger in size than {}, the largest sample the workflows compute with",
+                                       shortest((*values)[index]), shortest(largest_computable_sample)));
+}
+
 }  // namespace backlash::measurements

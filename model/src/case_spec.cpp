@@ -306,7 +306,7 @@ class CaseFileReader {
   Experiment read_experiment(const toml::node& node, long fallback_line) const {
     const toml::table& experiment = require_table(node, "experiment");
     const long header_line = line_of(experiment, fallback_line);
-    reject_unknown_keys(experiment, "experiment", {"kind", "step", "t_end", "drive_gain"});
+    reject_unknown_keys(experiment, "experiment", {"kind", "step", "t_end", "drive_gain", "step_time"});
     Experiment parsed;
     if (const toml::node* kind_node = experiment.get("kind")) {
       const auto* text = kind_node->as_string();
@@ -321,7 +321,12 @@ class CaseFileReader {
         fail(line_of(*gain_node, header_line), "experiment.drive_gain",
              "only a measured-drive experiment (kind = \"drive\") has a drive gain");
       parsed.step = read_number(require(experiment, "experiment", header_line, "step"), "experiment.step").value;
+      if (const toml::node* time_node = experiment.get("step_time"))
+        parsed.step_time = read_number(*time_node, "experiment.step_time").value;
     } else {
+      if (const toml::node* time_node = experiment.get("step_time"))
+        fail(line_of(*time_node, header_line), "experiment.step_time",
+             "a measured-drive experiment has no step: the drive comes from the record's drive column");
       if (const toml::node* step_node = experiment.get("step"))
         fail(line_of(*step_node, header_line), "experiment.step",
              "a measured-drive experiment has no step: the drive comes from the record's drive column");

@@ -33,6 +33,7 @@ void write_experiment(std::ostream& out, const ExperimentText& x) {
   else
     out << "kind = \"drive\"\ndrive_gain = " << x.drive_gain << "\n";
   if (x.t_end) out << "t_end = " << *x.t_end << "\n";
+  if (x.step_time) out << "step_time = " << *x.step_time << "\n";
 }
 
 /// [effects]: each effect whose first parameter is present, `KEY = v` or `KEY = { k = v, ... }`.
@@ -86,8 +87,9 @@ std::string write_case_file(const CaseSpec& s) {
   c.Jm = exact_text(s.Jm), c.Fm = exact_text(s.Fm), c.JL = exact_text(s.JL), c.FL = exact_text(s.FL);
   if (s.experiment) {
     const Experiment& x = *s.experiment;
-    c.experiment = ExperimentText{x.kind, exact_text(x.step), exact_text(x.drive_gain), std::nullopt};
+    c.experiment = ExperimentText{x.kind, exact_text(x.step), exact_text(x.drive_gain), std::nullopt, std::nullopt};
     if (x.t_end) c.experiment->t_end = exact_text(*x.t_end);
+    if (x.step_time) c.experiment->step_time = exact_text(*x.step_time);
   }
   for (const EffectInfo& effect : effects_table) {
     if (!s.effects.has(effect)) continue;

@@ -152,10 +152,22 @@ def read_record(file):
 
 
 def record(t, theta_out, theta_motor=None, theta_load=None, drive=None, name="<arrays>"):
-    """A measured record from arrays (checked by the CSV contract)."""
-    def column(values):
-        return None if values is None else [float(v) for v in values]
-    return _core.make_record(column(t), column(theta_out), column(theta_motor), column(theta_load), column(drive), name)
+    """A measured record from arrays (checked by the CSV contract): real numbers only, a
+    complex array (even with zero imaginary parts) is a ValueError naming the column."""
+    def column(values, label):
+        if values is None:
+            return None
+        if any(isinstance(v, complex) or _is_complex_dtype(v) for v in ([values] + list(values))):
+            raise ValueError(f"{name}: {label}: complex values, expected real numbers")
+        return [float(v) for v in values]
+    return _core.make_record(column(t, "t"), column(theta_out, "theta_out"), column(theta_motor, "theta_motor"),
+                             column(theta_load, "theta_load"), column(drive, "drive"), name)
+
+
+def _is_complex_dtype(value):
+    """True for a NumPy array or scalar of a complex type (float() would drop its imaginary part)."""
+    kind = getattr(getattr(value, "dtype", None), "kind", None)
+    return kind == "c"
 
 
 def discrepancy(model, data, step=None, threads=2, cutoff=None, window=None, validation=None):

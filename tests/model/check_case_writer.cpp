@@ -65,8 +65,10 @@ TEST(CaseWriter, check_RandomCasesWithEveryEffectRoundTrip) {
     spec.Jm = random_rational(random, true), spec.FL = random_rational(random, true);
     spec.reference = random_rational(random, false);
     spec.measured_at = trial % 2 ? model::MeasuredAt::Motor : model::MeasuredAt::Load;
-    if (trial % 3 == 0) spec.experiment = model::Experiment{model::ExperimentKind::Drive, 0, random_rational(random, true), {}};
+    if (trial % 3 == 0) spec.experiment = model::Experiment{model::ExperimentKind::Drive, 0, random_rational(random, true), {}, {}};
     if (trial % 5 == 0 && spec.experiment) spec.experiment->t_end = random_rational(random, true);
+    if (trial % 7 == 1 && spec.experiment && spec.experiment->kind == model::ExperimentKind::Step)
+      spec.experiment->step_time = random_rational(random, false);  // issue 18, item 4: it round-trips
     if (trial % 4 == 0) spec.fit_free = {"motor.J", "load.F"};
     // Each effect present or not; one contact law at most (the reader refuses the pair).
     bool contact_law = false;

@@ -33,6 +33,7 @@ std::string corrected_case_file(const model::CaseSpec& spec, const DiscrepancyRe
   model::ExperimentText x;
   x.step = spec.experiment ? model::exact_or_decimal(spec.experiment->step, step) : model::decimal_text(step);
   if (spec.experiment && spec.experiment->t_end) x.t_end = model::exact_text(*spec.experiment->t_end);
+  if (spec.experiment && spec.experiment->step_time) x.step_time = model::exact_text(*spec.experiment->step_time);
   c.experiment = x;
   c.effects = model::fitted_effect_texts(spec.effects, result.corrected_effects);
   return model::write_case_file(c);

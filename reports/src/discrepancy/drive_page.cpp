@@ -167,7 +167,8 @@ std::string drive_corrected_case_file(const model::CaseSpec& spec, const DriveDi
   c.K = model::exact_text(spec.K), c.backlash = "0", c.reference = model::exact_text(spec.reference);
   c.Jm = model::exact_or_decimal(spec.Jm, p.Jm), c.Fm = model::exact_or_decimal(spec.Fm, p.Fm);
   c.JL = model::exact_or_decimal(spec.JL, p.JL), c.FL = model::exact_or_decimal(spec.FL, p.FL);
-  model::ExperimentText x{model::ExperimentKind::Drive, "", model::exact_text(spec.experiment->drive_gain), std::nullopt};
+  model::ExperimentText x{model::ExperimentKind::Drive, "", model::exact_text(spec.experiment->drive_gain), std::nullopt,
+                         std::nullopt};
   if (spec.experiment->t_end) x.t_end = model::exact_text(*spec.experiment->t_end);
   c.experiment = x;
   c.fit_free = spec.fit_free;

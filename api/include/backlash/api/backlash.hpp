@@ -377,6 +377,9 @@ struct DiscrepancyRequest {
   /// same drive scored with the fitted models (not refitted).
   std::optional<double> cutoff{}, window{};
   std::optional<measurements::MeasuredRecord> validation{};
+  /// Step workflow: set, called as each candidate of a round is fitted (done of total;
+  /// serialised; each round starts again from 0) — the CLI's progress bar on a terminal.
+  std::function<void(long done, long total)> progress{};
 };
 
 /// `discrepancy`: where the model and the record disagree, the missing effect named and
@@ -409,7 +412,9 @@ class Discrepancy {
 /// The workflow.  BadInput "step" (0, missing — as model::CaseFileError
 /// "FILE:1: experiment.step: ..." when the model file has no step either —, or given for a
 /// measured drive), "threads", "cutoff", "window", "validation" (only for a measured drive);
-/// BadInput "data" for a record the model cannot be compared with.
+/// BadInput "data" for a record the model cannot be compared with; MeasuredDataError naming
+/// the line for a sample larger in size than 1e100 (measurements::require_computable) and,
+/// for a step, a record that does not cover the step ([experiment] step_time) or has a gap.
 Discrepancy discrepancy(const Case& model, const measurements::MeasuredRecord& data,
                         const DiscrepancyRequest& request = {});
 

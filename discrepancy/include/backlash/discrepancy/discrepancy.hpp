@@ -44,6 +44,7 @@
 #include "backlash/numeric/hybrid_simulation.hpp"
 
 #include <cmath>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -107,6 +108,9 @@ struct DiscrepancyOptions {
   /// events it simulated — reaches this (a stiff mesh can be slow).  A count, not a clock, so that
   /// the result is the same on any machine; 3e6 is about 3 s of a stiff mesh's fit here.
   long candidate_work = 3'000'000;
+  /// Set: called as each candidate of a round is fitted, `done` of the round's `total`
+  /// candidates (from the worker threads, serialised); a new round starts again from 0.
+  std::function<void(long done, long total)> progress{};
 };
 
 struct DiscrepancyResult {

@@ -67,6 +67,21 @@ struct CsvReadOptions {
   std::uintmax_t max_file_bytes = default_max_file_bytes;
 };
 
+/// The largest size of a sample the workflows compute with (docs/design.md, "Measured data
+/// (CSV)"): the case files' own bound (model/case_spec.hpp), so that sums of squares over a
+/// record stay finite doubles.  The CSV contract itself holds any finite number.
+inline constexpr double largest_computable_sample = 1e100;
+
+/// The error naming sample `index` (0-based) of `column`: "FILE:LINE: COLUMN: problem" for a
+/// record from CSV text (LINE = index + 2, the header being line 1), "FILE: COLUMN: sample
+/// N: problem" (N 1-based) for one read from a .mat file.
+MeasuredDataError sample_error(const MeasuredRecord& record, std::size_t index, const std::string& column,
+                               const std::string& problem);
+
+/// Throws sample_error for the first sample (any column, `t` included) larger in size than
+/// largest_computable_sample: such a record is bad input to a workflow, not a computation.
+void require_computable(const MeasuredRecord& record);
+
 /// The column names of the contract, in the order the writer uses.
 const std::vector<std::string>& measured_csv_columns();
 
@@ -97,7 +112,9 @@ std::string format_measured_csv(const MeasuredRecord& record);
 /// temporary file in target's directory, flushed to disk, then renamed over
 /// `target`.  Refuses (MeasuredDataError naming `target`) to replace anything
 /// that is not a regular file — a directory, a device such as /dev/null, a
-/// symbolic link — and a directory that does not exist.  On any failure the
+/// symbolic link — and a directory that does not exist.  A write that fails (a full disk,
+/// a folder it may not write in) is output::OutputError (write_failed: exit 1, not bad
+/// input), what() "TARGET: cannot write: …".  On any failure the
 /// temporary file is removed and an existing `target` is left untouched.
 /// A new file gets mode 0644, a replaced one keeps its permission bits.
 void write_measured_csv(const MeasuredRecord& record, const std::filesystem::path& target);

@@ -39,6 +39,9 @@ struct Experiment {
   Rational step;                 ///< step experiments (0 for a measured drive)
   Rational drive_gain{1};        ///< measured drive: torque per unit of the `drive` column
   std::optional<Rational> t_end;
+  /// Step experiments: the time of the step on a measured record's clock [s] (absent: 0, the
+  /// record starts with the step).  Only the discrepancy workflow reads it (docs/discrepancy.md).
+  std::optional<Rational> step_time;
 };
 
 /// The effects the thesis left out (docs/effects.md), as read from the optional [effects]

@@ -33,6 +33,7 @@ struct ExperimentText {
   std::string step;        ///< a step experiment's step
   std::string drive_gain;  ///< a measured drive's gain
   std::optional<std::string> t_end;
+  std::optional<std::string> step_time;  ///< a step experiment's step time, when the file gives one
 };
 
 /// A case file's contents, every number as the text it is written as.
