@@ -19,7 +19,7 @@ struct EffectsEngineOptions {
   double extremes_after = 0;
   /// The delayed model's work budget: integration steps per run (each no longer than the delay),
   /// then the status work_limit, exit 3 (docs/effects.md, "Delay").
-  long max_delay_steps = 4'000'000;
+  long max_delay_steps = 20'000'000;
 };
 
 /// The accumulation threshold of docs/effects.md: a bounce series whose remaining duration is
