@@ -5,6 +5,7 @@
 #include "format.hpp"
 
 #include "backlash/measurements/emps.hpp"
+#include "backlash/numeric/scales.hpp"
 
 #include <cmath>
 
@@ -102,6 +103,11 @@ Discrepancy discrepancy(const Case& model, const measurements::MeasuredRecord& d
     throw model::CaseFileError(spec.source, 1, "experiment.step",
                                "the model has no [experiment] step and no step was given: there is nothing to compare");
   }
+  // A step whose motion double precision cannot resolve against the backlash is refused before
+  // any work, as simulate refuses it (numeric/scales.hpp).
+  const std::string what = request.step ? "the step " + number_text(step) : "the step of the case file";
+  if (const auto problem = numeric::resolution_problem(numeric::parameters_of(spec), std::fabs(step), what))
+    throw BadInput("step", *problem);
   if (request.threads < 1 || request.threads > 256)
     throw BadInput("threads", "expected an integer from 1 to 256, got " + std::to_string(request.threads));
   discrepancy::DiscrepancyOptions options;

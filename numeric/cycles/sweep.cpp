@@ -114,7 +114,9 @@ SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& fam
   const double reference = q.theta_R;
   q.theta_R = 0;
   try {
-    if (const std::optional<std::string> problem = parameter_scale_problem(q)) {
+    std::optional<std::string> problem = parameter_scale_problem(q);
+    if (!problem) problem = effect_scale_problem(q, point.effects);
+    if (problem) {
       row.status = SweepStatus::Refused;
       row.reason = *problem;
       c.guess = 0, c.warm.reset();

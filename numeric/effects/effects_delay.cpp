@@ -6,7 +6,11 @@
 //     breakpoints t_event + τ, t_event + 2τ where the delayed signal's derivatives jump,
 //     and on the times where the delayed demand K(θR − θo(t − τ)) crosses ±L;
 //   – the history is stored as quintic Hermite pieces (θo, θ̇o, θ̈o at each step's ends:
-//     O(h⁶) between them, below the integrator's own error);
+//     O(h⁶) between them, below the integrator's own error), and only as far back as the
+//     delay reaches (t − τ): memory does not grow with t_end;
+//   – a segment keeps at most max_segment_steps steps (a longer one ends there and the engine
+//     starts the next, as at a breakpoint), and a run at most EffectsEngineOptions::
+//     max_delay_steps (then work_limit): the cost is about t_end/min(τ, 0.1/rate) steps;
 //   – guards are the engine's witnesses with the drive as an input (w = row·z + c + k·D(t)),
 //     sampled inside each step on the step's quintic Hermite interpolant and refined with
 //     Boost.Math's toms748.
@@ -23,9 +27,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <deque>
 #include <limits>
 #include <map>
 #include <set>
+#include <string>
 
 namespace backlash::numeric::detail {
 
@@ -35,6 +42,8 @@ namespace odeint = boost::numeric::odeint;
 
 constexpr double tolerance = 1e-13;  // dopri5 absolute = relative error per step (1e-11 drifted 1e-10 s per s)
 constexpr int samples_per_step = 6;  // witness samples inside each step (plus its end)
+// Steps kept by one segment (for its states and extremes): 65536 steps of 272 bytes, 18 MB.
+constexpr std::size_t max_segment_steps = 1 << 16;
 
 struct Jet {
   double value = 0, rate = 0, acceleration = 0;
@@ -77,7 +86,19 @@ class Quintic {
 // The history of θo and the delayed drive read from it.
 class DelayLine {
  public:
-  DelayLine(const Parameters& p, const Effects& e, double theta_o0) : p_(p), e_(e), initial_(theta_o0) {}
+  DelayLine(const Parameters& p, const Effects& e, double theta_o0, long max_steps)
+      : p_(p), e_(e), initial_(theta_o0), max_steps_(max_steps) {}
+
+  /// Counts one integration step against the run's budget (SearchBudgetExhausted beyond it).
+  void count_step(double t, double dt_max) {
+    if (++steps_ <= max_steps_) return;
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "the delayed model used its budget of %ld integration steps (of at most %.3g s: the delay or "
+                  "0.1 of the fastest time scale) by t = %.6g s",
+                  max_steps_, dt_max, t);
+    throw SearchBudgetExhausted(text);
+  }
 
   double end() const { return pieces_.empty() ? 0.0 : pieces_.back().end(); }
   double last_motion() const { return last_motion_; }
@@ -85,6 +106,7 @@ class DelayLine {
   /// Appends θo on [t0, t1]; anything recorded beyond t0 is dropped first.
   void append(double t0, double t1, const Jet& y0, const Jet& y1) {
     while (!pieces_.empty() && pieces_.back().start() >= t0) pieces_.pop_back();
+    forget_before(t0 - e_.delay);
     if (!(t1 > t0)) return;
     pieces_.emplace_back(t0, t1, y0, y1);
     if (y0.rate != 0 || y1.rate != 0 || y0.value != y1.value) last_motion_ = std::max(last_motion_, t1);
@@ -123,6 +145,18 @@ class DelayLine {
   }
 
  private:
+  // Nothing before `s` is read again: the drive at t ≥ t0 reads θo at t − τ ≥ t0 − τ, and the
+  // regime changes before t0 have been reported.
+  void forget_before(double s) {
+    std::size_t dropped = 0;
+    while (pieces_.size() > 1 && pieces_.front().end() < s) {
+      pieces_.pop_front();
+      ++dropped;
+    }
+    cursor_ = cursor_ > dropped ? cursor_ - dropped : 0;
+    changes_.erase(changes_.begin(), changes_.lower_bound(s));
+  }
+
   // θo crossing θR ∓ L/K at s makes the demand at s + τ cross ±L.
   void schedule_regime_changes(const Quintic& piece) {
     if (!e_.saturating()) return;
@@ -150,20 +184,14 @@ class DelayLine {
   const Parameters& p_;
   const Effects& e_;
   double initial_;
-  std::vector<Quintic> pieces_;
+  long max_steps_, steps_ = 0;
+  std::deque<Quintic> pieces_;
   mutable std::size_t cursor_ = 0;
   double last_motion_ = 0;
   std::map<double, int> changes_;
 };
 
 using Vector = std::array<double, 4>;
-
-double fastest_rate_with_mesh(const Parameters& p, const Effects& e) {
-  double rate = fastest_mode_rate(p);
-  if (e.compliant())
-    rate = std::max(rate, std::sqrt(e.mesh_stiffness * (1 / p.Jm + 1 / p.JL)) + e.mesh_damping * (1 / p.Jm + 1 / p.JL));
-  return rate;
-}
 
 // One mode integrated from the engine's state, with its guards.
 class DelayedSegment final : public Segment {
@@ -180,11 +208,12 @@ class DelayedSegment final : public Segment {
     witnesses_ = mode_witnesses(p, e, m, functionals_, false);
     const double stop = std::min(t0 + horizon, stop_at);
     const bool stuck = m.kind == ModeKind::Contact ? m.slip_motor == 0 : (m.slip_motor == 0 && m.slip_load == 0);
-    if (stuck)
+    if (stuck) {
       hold_still(stop);
-    else
-      integrate(stop);
-    finish_at(stop);
+      finish_at(stop);
+    } else {
+      finish_at(integrate(stop));
+    }
   }
 
   HybridState state(double tau) const override { return state_of(z_at(t0_ + tau)); }
@@ -353,15 +382,16 @@ class DelayedSegment final : public Segment {
     if (!exit && quiet <= stop) rest = true;
   }
 
-  void integrate(double stop) {
-    const double dt_max = std::min(e_.delay, 0.1 / fastest_rate_with_mesh(p_, e_));
+  // Returns where the segment ends: `stop`, an exit, or the end of its last kept step.
+  double integrate(double stop) {
+    const double dt_max = std::min(e_.delay, 0.1 / fastest_mode_rate(p_, e_));
     std::vector<Arming> arming(witnesses_.size());
     std::vector<double> tolerances(witnesses_.size());
     for (std::size_t i = 0; i < witnesses_.size(); ++i) {
       arming[i] = arm(witnesses_[i], tolerances[i]);
       if (arming[i] == Arming::ExitNow) {
         exit = Exit{0, witnesses_[i], false};
-        return;
+        return stop;
       }
     }
     auto rhs = [this](const Vector& x, Vector& dx, double t) {
@@ -420,7 +450,10 @@ class DelayedSegment final : public Segment {
       za1 = zb1;
       za2 = zb2;
       if (!exit && t == end && end < stop) regime_change(end);
+      line_.count_step(t, dt_max);
+      if (!exit && t < stop && steps_.size() >= max_segment_steps) return t;  // the engine goes on from here
     }
+    return stop;
   }
 
   // The delayed drive enters or leaves its limit at t: an exit of this segment.
@@ -501,7 +534,7 @@ class DelayedEngine final : public Engine {
  public:
   DelayedEngine(const Parameters& p, const Effects& e, const SimulationOptions& options,
                 const EffectsEngineOptions& engine, double theta_o0)
-      : Engine(p, e, options, engine), line_(p, e, theta_o0) {
+      : Engine(p, e, options, engine), line_(p, e, theta_o0, engine.max_delay_steps) {
     breakpoints_.insert(e.delay);
     breakpoints_.insert(2 * e.delay);
   }
@@ -519,6 +552,7 @@ class DelayedEngine final : public Engine {
     const Mode m = mode;
     double stop = t_ + remaining;
     const double slack = 1e-12 * std::max(1.0, t_);
+    breakpoints_.erase(breakpoints_.begin(), breakpoints_.lower_bound(t_ - e_.delay));  // behind us
     if (auto b = breakpoints_.upper_bound(t_ + slack); b != breakpoints_.end()) stop = std::min(stop, *b);
     const auto& changes = line_.regime_changes();
     if (auto c = changes.upper_bound(t_ + slack); c != changes.end()) stop = std::min(stop, c->first);

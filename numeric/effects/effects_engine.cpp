@@ -140,6 +140,11 @@ SimulationResult Engine::finish(SimulationStatus status) {
   return std::move(result_);
 }
 
+SimulationResult Engine::stop(SimulationStatus status, std::string reason) {
+  result_.stop_reason = std::move(reason);
+  return finish(status);
+}
+
 void Engine::push(EventKind kind, Body body, bool bounce, bool grazing, bool accumulation) {
   SimulationEvent e;
   e.t = t_;
@@ -419,11 +424,21 @@ bool finite(const HybridState& s) {
 
 SimulationResult Engine::run(const HybridState& start) {
   state_ = start;
-  settle();
+  try {
+    settle();
+    return advance();
+  } catch (const SearchBudgetExhausted& budget) {  // a certified search, or the delayed model's steps
+    return stop(SimulationStatus::WorkLimit, budget.what());
+  }
+}
+
+SimulationResult Engine::advance() {
   while (t_ < o_.t_end) {
-    if (!finite(state_)) return finish(SimulationStatus::NonFinite);
-    if (static_cast<long>(result_.events.size()) >= o_.max_events) return finish(SimulationStatus::EventLimit);
-    if (static_cast<int>(impacts_.size()) >= o_.zeno_impacts) return finish(SimulationStatus::Chattering);
+    if (!finite(state_)) return stop(SimulationStatus::NonFinite, "the state is no longer finite");
+    if (static_cast<long>(result_.events.size()) >= o_.max_events)
+      return stop(SimulationStatus::EventLimit, event_limit_reason(o_));
+    if (static_cast<int>(impacts_.size()) >= o_.zeno_impacts)
+      return stop(SimulationStatus::Chattering, zeno_reason(o_, zeno_window(p_, o_)));
     if (o_.stop_after_separations > 0 && separations_ >= o_.stop_after_separations)
       return finish(SimulationStatus::Completed);
     if (stop_reached_) return finish(SimulationStatus::Completed);

@@ -123,6 +123,8 @@ class Engine {
 
  private:
   SimulationResult finish(SimulationStatus status);
+  SimulationResult stop(SimulationStatus status, std::string reason);
+  SimulationResult advance();
   void push(EventKind kind, Body body = Body::None, bool bounce = false, bool grazing = false, bool accumulation = false);
   bool at_rest(const Mode& m) const;
   void settle();

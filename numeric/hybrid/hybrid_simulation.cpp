@@ -70,6 +70,10 @@ std::string zeno_reason(const SimulationOptions& options, double window) {
   return text;
 }
 
+std::string event_limit_reason(const SimulationOptions& options) {
+  return "the event cap of " + std::to_string(options.max_events) + " events was reached";
+}
+
 double measured(const Parameters& p, const HybridState& s) {
   return p.measured_at == model::MeasuredAt::Motor ? s.theta_m : s.theta_L;
 }
@@ -250,8 +254,7 @@ class ClosedFormRun {
       while (t_ < o_.t_end) {
         if (!finite(state_)) return stop(SimulationStatus::NonFinite, "the state is no longer finite");
         if (events_ >= o_.max_events)
-          return stop(SimulationStatus::EventLimit,
-                      "the event cap of " + std::to_string(o_.max_events) + " events was reached");
+          return stop(SimulationStatus::EventLimit, event_limit_reason(o_));
         if (auto problem = resolution_problem(p_, motion_scale(p_, state_.theta_m, state_.theta_L), "the motion"))
           return stop(SimulationStatus::Unresolved, *problem);
         const std::optional<SimulationStatus> end = state_.in_contact ? contact() : flight();

@@ -1,5 +1,6 @@
 #include "backlash/numeric/scales.hpp"
 
+#include "backlash/numeric/effects.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
 
 #include <algorithm>
@@ -19,6 +20,14 @@ std::string number(double value) {
 }
 
 bool normal_or_zero(double value) { return value == 0 || std::isnormal(value); }
+
+// The time scale of an overdamped mode's slow root, 1/(w²/(α + sqrt(α² − w²))) for
+// s² + 2αs + w² with α > w (about 2α/w²: the contact creeping toward θR when F² ≫ 4JK), else 0.
+// slowest_time_scale counts a decay as α; an overdamped mode decays far slower than that.
+double overdamped_time_scale(double two_alpha, double w2) {
+  const double alpha = two_alpha / 2, D = alpha * alpha - w2;
+  return D > 0 ? (alpha + std::sqrt(D)) / w2 : 0.0;
+}
 
 }  // namespace
 
@@ -57,8 +66,9 @@ std::optional<std::string> parameter_scale_problem(const Parameters& p) {
       return std::string(d.name) + " = " + number(d.value) +
              " is outside double precision (the parameters are too far apart in size)";
   // Stiffness: the fastest rate against the slowest time scale.
-  const double fastest = fastest_mode_rate(p), slowest = slowest_time_scale(p);
-  const double stiffness = fastest * slowest;
+  double slowest = std::max(slowest_time_scale(p), overdamped_time_scale(F / J, p.K / J));
+  if (p.measured_at == model::MeasuredAt::Motor) slowest = std::max(slowest, overdamped_time_scale(p.Fm / p.Jm, p.K / p.Jm));
+  const double fastest = fastest_mode_rate(p), stiffness = fastest * slowest;
   if (!std::isfinite(stiffness) || stiffness > max_stiffness) {
     const double rates[] = {F / J + std::sqrt(p.K / J), p.Fm / p.Jm + std::sqrt(p.K / p.Jm), p.FL / p.JL};
     const char* names[] = {"the contact mode ((motor.F + load.F)/J + sqrt(K/J), J = motor.J + load.J)",
@@ -69,6 +79,76 @@ std::optional<std::string> parameter_scale_problem(const Parameters& p) {
            number(max_stiffness) + ": no event search can span it in double precision";
   }
   return std::nullopt;
+}
+
+double fastest_mode_rate(const Parameters& p, const Effects& e) {
+  double rate = fastest_mode_rate(p);
+  if (e.compliant()) {
+    const double m = 1 / p.Jm + 1 / p.JL;
+    rate = std::max(rate, std::sqrt(e.mesh_stiffness * m) + e.mesh_damping * m);
+  }
+  return rate;
+}
+
+namespace {
+
+// The case-file key of a parameter: "delay", "compliance.stiffness".
+std::string key_of(const model::EffectParameterInfo& parameter) {
+  return parameter.key == parameter.effect ? std::string(parameter.key)
+                                           : std::string(parameter.effect) + "." + std::string(parameter.key);
+}
+
+// Each present parameter a finite, normal double (or 0) inside its admissible range (the table's
+// ADMISSIBLE and PROBLEM columns: the reader's rule, for models built in code as well).
+std::optional<std::string> effect_value_problem(const Effects& e) {
+  for (const model::EffectParameterInfo& parameter : model::effect_parameters) {
+    const double value = model::field(e, parameter.id);
+    if (parameter.is_neutral(value)) continue;
+    const std::string key = key_of(parameter);
+    if (!std::isfinite(value)) return key + " is not a finite number";
+    if (!parameter.admits(value)) return key + " = " + number(value) + ": " + std::string(parameter.problem);
+    if (!normal_or_zero(value))
+      return key + " = " + number(value) + " is below the smallest normal double (2.2e-308)";
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<std::string> effect_scale_problem(const Parameters& p, const Effects& e) {
+  if (auto problem = effect_value_problem(e)) return problem;
+  const double slowest = slowest_time_scale(p);
+  if (e.compliant()) {
+    // The engaged mesh is a mode like the others: its rate against the slowest time scale.
+    const double m = 1 / p.Jm + 1 / p.JL, spring = std::sqrt(e.mesh_stiffness * m), damper = e.mesh_damping * m;
+    const double rate = spring + damper, stiffness = rate * slowest;
+    if (!std::isfinite(stiffness) || stiffness > max_stiffness)
+      return std::string(spring >= damper ? "compliance.stiffness = " + number(e.mesh_stiffness)
+                                          : "compliance.damping = " + number(e.mesh_damping)) +
+             ": time scales too far apart: the engaged mesh's rate, " + number(rate) +
+             "/s (sqrt(stiffness (1/motor.J + 1/load.J)) + damping (1/motor.J + 1/load.J)), times the slowest "
+             "time scale, " + number(slowest) + " s, is " + number(stiffness) + " > " + number(max_stiffness) +
+             ": no event search can span it in double precision";
+  }
+  if (e.delayed()) {
+    const double shortest = min_delay_fraction / fastest_mode_rate(p, e);
+    if (e.delay < shortest)
+      return "delay = " + number(e.delay) + " s is shorter than " + number(min_delay_fraction) +
+             " of the fastest time scale (" + number(shortest) +
+             " s): the delayed model is integrated in steps no longer than the delay, so its cost grows as "
+             "t_end/delay; use delay = 0 (no delay) or a delay of at least " + number(shortest) + " s";
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> time_resolution_problem(const Parameters& p, const Effects& e, double t_end) {
+  const double fastest = fastest_mode_rate(p, e);
+  const double latest = backlash_resolution / (std::numeric_limits<double>::epsilon() * fastest);
+  if (t_end <= latest) return std::nullopt;
+  return "t_end = " + number(t_end) + " s: double precision resolves times there to " +
+         number(t_end * std::numeric_limits<double>::epsilon()) + " s, more than " + number(backlash_resolution) +
+         " of the fastest time scale " + number(1 / fastest) + " s (the latest end it resolves is " + number(latest) +
+         " s)";
 }
 
 double resolvable_scale(const Parameters& p) {

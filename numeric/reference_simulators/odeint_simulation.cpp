@@ -258,8 +258,7 @@ class OdeintRun {
       while (t_ < o_.t_end) {
         if (!finite(state_)) return stop(SimulationStatus::NonFinite, "the state is no longer finite");
         if (static_cast<long>(result_.events.size()) >= o_.max_events)
-          return stop(SimulationStatus::EventLimit,
-                      "the event cap of " + std::to_string(o_.max_events) + " events was reached");
+          return stop(SimulationStatus::EventLimit, event_limit_reason(o_));
         if (auto problem = resolution_problem(p_, motion_scale(p_, state_.theta_m, state_.theta_L), "the motion"))
           return stop(SimulationStatus::Unresolved, *problem);
         const std::optional<SimulationStatus> end = state_.in_contact ? contact() : flight();

@@ -45,22 +45,55 @@ double initial_step(const std::vector<double>& times) {
   return end > 0 ? std::min(1e-3, end * 1e-4) : 1e-3;
 }
 
-template <class Vector, class System, class Out>
-std::vector<Out> integrate(const System& system, Vector x0, const std::vector<double>& times, double tolerance,
-                           Out (*convert)(const Vector&)) {
+// odeint's integrate_times compares times with an absolute epsilon, 2.2e-16
+// (odeint/util/detail/less_with_sign.hpp): grid times below it count as reached before the
+// first step, where the dense output holds no state yet — a read through a null pointer (a
+// mesh of stiffness 1e40 is validated over 2e-18 s).  A grid that ends before 1 is therefore
+// integrated in the time s = t/u, u the power of two that puts its end in [1, 2): scaling by
+// a power of two is exact, so every product of the stepper keeps its bits.
+double time_unit(const std::vector<double>& times) {
+  const double end = times.empty() ? 0.0 : times.back();
+  if (!(end > 0) || end >= 1) return 1.0;
+  int exponent = 0;
+  (void)std::frexp(end, &exponent);  // end = m·2^exponent, m in [0.5, 1)
+  return std::ldexp(1.0, exponent - 1);
+}
+
+// The grid in units of u, from 0 (integrate_times starts at its first time): 0 is prepended
+// when the first time is later, and `prepended` says so.
+std::vector<double> scaled_grid(const std::vector<double>& times, double unit, bool& prepended) {
+  std::vector<double> grid;
+  grid.reserve(times.size() + 1);
+  prepended = times.front() > 0;
+  if (prepended) grid.push_back(0.0);
+  for (const double t : times) grid.push_back(t / unit);
+  return grid;
+}
+
+void check_complete(std::size_t computed, const std::vector<double>& times) {
+  if (computed != times.size())
+    throw std::runtime_error("reference trajectory: odeint stopped after " + std::to_string(computed) + " of " +
+                             std::to_string(times.size()) + " times");
+}
+
+template <class Vector, class System, class Convert>
+auto integrate(const System& system, Vector x0, const std::vector<double>& times, double tolerance,
+               const Convert& convert) {
+  using Out = decltype(convert(x0));
   check_times(times);
   std::vector<Out> out;
   out.reserve(times.size());
   if (times.empty()) return out;
   // integrate_times starts at the first time: begin at 0 and drop that sample if not asked for.
-  std::vector<double> grid;
-  grid.reserve(times.size() + 1);
-  const bool prepend = times.front() > 0;
-  if (prepend) grid.push_back(0.0);
-  grid.insert(grid.end(), times.begin(), times.end());
+  const double unit = time_unit(times);
+  bool skip = false;
+  const std::vector<double> grid = scaled_grid(times, unit, skip);
+  auto scaled = [&system, unit](const Vector& x, Vector& dx, double s) {
+    system(x, dx, s * unit);
+    for (double& d : dx) d *= unit;
+  };
   auto stepper = odeint::make_dense_output(tolerance, tolerance, odeint::runge_kutta_dopri5<Vector>());
-  bool skip = prepend;
-  odeint::integrate_times(stepper, system, x0, grid.begin(), grid.end(), initial_step(times),
+  odeint::integrate_times(stepper, scaled, x0, grid.begin(), grid.end(), initial_step(grid),
                           [&](const Vector& x, double) {
                             if (skip) {
                               skip = false;
@@ -68,6 +101,7 @@ std::vector<Out> integrate(const System& system, Vector x0, const std::vector<do
                             }
                             out.push_back(convert(x));
                           });
+  check_complete(out.size(), times);
   return out;
 }
 
@@ -113,24 +147,7 @@ std::vector<SmallVector> reference_linear_trajectory(const LinearSegment& segmen
     for (Eigen::Index i = 0; i < n; ++i) out(i) = z[i];
     return out;
   };
-  check_times(times);
-  std::vector<SmallVector> out;
-  if (times.empty()) return out;
-  std::vector<double> grid;
-  const bool prepend = times.front() > 0;
-  if (prepend) grid.push_back(0.0);
-  grid.insert(grid.end(), times.begin(), times.end());
-  Vector x(z0.data(), z0.data() + n);
-  auto stepper = odeint::make_dense_output(tolerance, tolerance, odeint::runge_kutta_dopri5<Vector>());
-  bool skip = prepend;
-  odeint::integrate_times(stepper, system, x, grid.begin(), grid.end(), initial_step(times), [&](const Vector& z, double) {
-    if (skip) {
-      skip = false;
-      return;
-    }
-    out.push_back(convert(z));
-  });
-  return out;
+  return integrate<Vector>(system, Vector(z0.data(), z0.data() + n), times, tolerance, convert);
 }
 
 }  // namespace backlash::numeric

@@ -145,13 +145,23 @@ const ValidatedEvaluator& ValidationResult::evaluator() const {
                          report_.failures());
 }
 
-std::optional<ValidatedEvaluator> in_error_coordinates(const ValidatedEvaluator& evaluator) {
+namespace {
+
+// The same evaluator with θR = 0, or nullptr (θR = 0 already, or a generated case).
+EvaluatorPtr centred_copy(const SegmentEvaluator& evaluator) {
   const Parameters& p = evaluator.parameters();
-  const std::string kind = evaluator.evaluator().kind();
-  if (p.theta_R == 0 || (kind != "parametric" && kind != "direct")) return std::nullopt;
+  const std::string kind = evaluator.kind();
+  if (p.theta_R == 0 || (kind != "parametric" && kind != "direct")) return nullptr;
   Parameters centred = p;
   centred.theta_R = 0;
-  EvaluatorPtr shifted = kind == "parametric" ? parametric_evaluator(centred) : direct_branch_evaluator(centred);
+  return kind == "parametric" ? parametric_evaluator(centred) : direct_branch_evaluator(centred);
+}
+
+}  // namespace
+
+std::optional<ValidatedEvaluator> in_error_coordinates(const ValidatedEvaluator& evaluator) {
+  EvaluatorPtr shifted = centred_copy(evaluator.evaluator());
+  if (!shifted) return std::nullopt;
   return ValidatedEvaluator(std::move(shifted), evaluator.report());
 }
 
@@ -247,11 +257,13 @@ ValidationResult validate(EvaluatorPtr evaluator, const ValidationOptions& o) {
   const char* free_names[] = {"theta_m", "dtheta_m", "theta_L", "dtheta_L", "gap"};
   std::vector<Tracker> free(5);
   for (int i = 0; i < 5; ++i) free[i].e.state = free_names[i];
-  compare_free_mode(*evaluator, o, r, free);
+  const EvaluatorPtr centred = o.error_coordinates ? centred_copy(*evaluator) : nullptr;
+  const SegmentEvaluator& compared = centred ? *centred : *evaluator;
+  compare_free_mode(compared, o, r, free);
   Tracker contact[2];
   contact[0].e.state = "theta_o";
   contact[1].e.state = "dtheta_o";
-  compare_contact_mode(*evaluator, o, r, contact);
+  compare_contact_mode(compared, o, r, contact);
   Tracker cot;
   cot.e.state = "cot_phi";
   cot.see(std::fabs(evaluator->cot_phi() - cot_phi(p)), std::fabs(cot_phi(p)), 0, 0, 0, 0);

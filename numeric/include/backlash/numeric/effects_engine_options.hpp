@@ -17,6 +17,9 @@ struct EffectsEngineOptions {
   EventKind stop_at_kind = EventKind::Recombination;
   /// With SimulationOptions::track_extremes: extremes only of segments starting at or after this time.
   double extremes_after = 0;
+  /// The delayed model's work budget: integration steps per run (each no longer than the delay),
+  /// then the status work_limit, exit 3 (docs/effects.md, "Delay").
+  long max_delay_steps = 20'000'000;
 };
 
 /// The accumulation threshold of docs/effects.md: a bounce series whose remaining duration is

@@ -133,6 +133,8 @@ inline constexpr double zeno_time_scales = 1e-6;
 double zeno_window(const Parameters& p, const SimulationOptions& options);
 /// The stop reason of a chattering run: the impact count and the window.
 std::string zeno_reason(const SimulationOptions& options, double window);
+/// The stop reason of a run that reached options.max_events.
+std::string event_limit_reason(const SimulationOptions& options);
 
 /// The measured shaft of a state, and its velocity.
 double measured(const Parameters& p, const HybridState& s);

@@ -14,6 +14,10 @@
 //                gap θL − θm between two angles of size S is rounding noise (a step of 1e16
 //                with b = 0.3), and an answer would be invented, not computed;
 //   rigid drive  b = 0 needs no resolution: the bodies never separate.
+// The effects' parameters pass the same checks (effect_scale_problem): each a finite, normal
+// double (or 0) inside its admissible range (the table of effects), and the mesh's rate held to
+// `max_stiffness` like the modes' own; a delay is at least `min_delay_fraction` of the fastest
+// time scale (docs/effects.md, "Delay").
 #pragma once
 
 #include "backlash/numeric/parametric.hpp"
@@ -22,6 +26,8 @@
 #include <string>
 
 namespace backlash::numeric {
+
+struct Effects;
 
 /// Largest stiffness (fastest rate × slowest time scale) accepted.
 inline constexpr double max_stiffness = 1e9;
@@ -34,6 +40,25 @@ double fastest_mode_rate(const Parameters& p);
 /// Why double precision or the searches cannot handle these parameters, or nothing.  The
 /// message names the parameters (K, motor.J, motor.F, load.J, load.F, backlash).
 std::optional<std::string> parameter_scale_problem(const Parameters& p);
+
+/// The fastest rate (1/s) of every mode with the effects: fastest_mode_rate(p) and the
+/// engaged mesh's, sqrt(kc·(1/Jm + 1/JL)) + cc·(1/Jm + 1/JL).
+double fastest_mode_rate(const Parameters& p, const Effects& e);
+
+/// The shortest delay resolved, in units of the fastest time scale 1/fastest_mode_rate(p, e):
+/// a shorter one changes the motion by less than the integration's own error while costing
+/// t_end/τ steps (docs/effects.md, "Delay").
+inline constexpr double min_delay_fraction = 1e-3;
+
+/// Why double precision or the searches cannot handle these effect parameters, or nothing.
+/// The message names the parameter by its case-file key ("compliance.stiffness", "delay").
+std::optional<std::string> effect_scale_problem(const Parameters& p, const Effects& e);
+
+/// Why a simulation to `t_end` cannot resolve its event times, or nothing: a time t carries
+/// ε·t of rounding, held (like the angles) to `backlash_resolution` of the fastest time scale,
+/// so t_end ≤ 1e-6/(ε·fastest_mode_rate(p, e)) — 3e9 s for the thesis's cases.  Beyond it the
+/// closed forms' sin and cos would be evaluated at arguments whose phase is rounding.
+std::optional<std::string> time_resolution_problem(const Parameters& p, const Effects& e, double t_end);
 
 /// The largest motion size S at which the backlash is still resolved (infinite for b = 0).
 double resolvable_scale(const Parameters& p);

@@ -46,6 +46,10 @@ struct ValidationOptions {
   double time_constants = 10;      ///< horizon in time constants of the slowest decaying pole
   double max_horizon = 200;        ///< cap on the horizon
   double max_rate_units = 400;     ///< cap on the horizon in units of 1/(the fastest rate of the modes)
+  /// Compare the centred copy (θR = 0) of a parametric or direct evaluator — the copy the
+  /// simulators run (in_error_coordinates) — instead of the evaluator itself, whose angles carry
+  /// |θR|·ε of rounding (θR = 1e7: 1e-9 rad, the whole tolerance).  The facade's models do.
+  bool error_coordinates = false;
 };
 
 struct StateError {
