@@ -147,6 +147,7 @@ struct Iteration {
   HybridState state;   ///< the fixed point of P^k, or where the iteration stopped
   int cycles = 0;
   int period_count = 1;  ///< k
+  bool newton = false;   ///< converged by Newton's method (not by the iteration)
   double residual = 0;
   double rest_error = 0;
 };
@@ -226,7 +227,9 @@ Iteration iterate(const Section& section, HybridState s, const EffectLimitCycleO
 // found by the iteration may be one of a lower power (an unstable cycle of period 1, say).
 int minimal_period(const Section& section, const HybridState& fixed, int k) {
   const Vector star = section.coordinates(fixed);
-  Section::Return r{.valid = true, .state = fixed};
+  Section::Return r;
+  r.valid = true;
+  r.state = fixed;
   for (int j = 1; j < k; ++j) {
     r = section.next(r.state);
     if (!r.valid) return k;
@@ -235,12 +238,20 @@ int minimal_period(const Section& section, const HybridState& fixed, int k) {
   return k;
 }
 
+Iteration newton(const ValidatedEffectModel& model, const Section& section, HybridState s, int k);
+double multiplier_from_jacobian(const ValidatedEffectModel& model, const Section& section, const HybridState& fixed,
+                                int k);
+
 // From a seed: P, and when P does not settle, P², P³, P⁴ from where the previous iteration
-// stopped (a period-k cycle is a fixed point of P^k).
-Iteration iterate_periods(const Section& section, const HybridState& seed, const EffectLimitCycleOptions& o,
-                          double velocity_scale) {
+// stopped (a period-k cycle is a fixed point of P^k); when none settles, Newton's method on
+// P, P², … from where each stopped.
+Iteration iterate_periods(const ValidatedEffectModel& model, const Section& section, const HybridState& seed,
+                          const EffectLimitCycleOptions& o, double velocity_scale) {
   Iteration it = iterate(section, seed, o, velocity_scale);
+  // Where the iterations of P, P², … stopped, for Newton's method (a slow or unstable cycle).
+  std::vector<HybridState> stops;
   for (int k = 2; k <= max_period && it.verdict == Verdict::Unresolved && it.cycles > 0; ++k) {
+    stops.push_back(it.state);
     Iteration next = iterate(section, it.state, o, velocity_scale, k);
     if (next.verdict == Verdict::Unresolved && next.cycles > 0) {
       it.state = next.state;
@@ -248,6 +259,18 @@ Iteration iterate_periods(const Section& section, const HybridState& seed, const
     }
     it = next;
   }
+  if (it.verdict == Verdict::Unresolved && it.cycles > 0) stops.push_back(it.state);
+  // A stable cycle first (the iterations' attractor, converging slowly); else the first
+  // unstable one Newton found.
+  std::optional<Iteration> unstable;
+  for (std::size_t j = 0; j < stops.size() && it.verdict == Verdict::Unresolved && it.cycles > 0; ++j) {
+    const int k = static_cast<int>(j) + 1;
+    const Iteration polished = newton(model, section, stops[j], k);
+    if (!polished.converged()) continue;
+    if (std::fabs(multiplier_from_jacobian(model, section, polished.state, k)) < 1) it = polished;
+    else if (!unstable) unstable = polished;
+  }
+  if (it.verdict == Verdict::Unresolved && unstable) it = *unstable;
   if (it.converged()) it.period_count = minimal_period(section, it.state, it.period_count);
   if (it.verdict == Verdict::Unresolved && it.cycles > 0)
     it.outcome = "the return map did not settle within " + std::to_string(o.max_cycles) +
@@ -281,6 +304,50 @@ double multiplier_along_a_ray(const Section& section, const HybridState& fixed, 
   return a1 != a0 ? (q1 * a0 - q0 * a1) / (a0 - a1) : q1;
 }
 
+// Directions along Σ at s: both angles together, the common velocity, and — with a compliant
+// mesh or after a bounce, where the two velocities are independent — the relative velocity.
+std::vector<Vector> tangent_directions(const ValidatedEffectModel& model, const HybridState& s) {
+  std::vector<Vector> directions{Vector::Unit(4, 0) + Vector::Unit(4, 2), Vector::Unit(4, 1) + Vector::Unit(4, 3)};
+  if (model.effects().compliant() || s.dtheta_m != s.dtheta_L) directions.push_back(Vector::Unit(4, 1) - Vector::Unit(4, 3));
+  return directions;
+}
+
+// Newton's method on F(x) = P^k(x) − x along Σ, from where an iteration stopped (a slowly
+// converging or an unstable cycle): x ← x + D·c with (W − D)·c = −F in least squares, D the
+// tangent directions and W = DP^k·D by central differences.  Converged when |F| ≤ 1e-11 of
+// the state (the differences' rounding bounds what Newton can reach).
+Iteration newton(const ValidatedEffectModel& model, const Section& section, HybridState s, int k) {
+  Iteration it;
+  it.period_count = k;
+  for (int step = 0; step < 8; ++step) {
+    const Section::Return r = section.next(s, k);
+    if (!r.valid) return it;
+    const Vector x = section.coordinates(s), F = section.coordinates(r.state) - x;
+    it.residual = F.cwiseAbs().maxCoeff();
+    if (it.residual <= 1e-11 * scale_of(x)) {
+      it.verdict = Verdict::Converged;
+      it.newton = true;
+      it.state = s;
+      it.cycles = step;
+      return it;
+    }
+    const std::vector<Vector> directions = tangent_directions(model, s);
+    const double h = 1e-6 * scale_of(x);
+    Eigen::MatrixXd D(4, static_cast<Eigen::Index>(directions.size())), W = D;
+    for (Eigen::Index i = 0; i < D.cols(); ++i) {
+      D.col(i) = directions[static_cast<std::size_t>(i)];
+      const Section::Return plus = section.next(section.state(x + h * D.col(i), s), k);
+      const Section::Return minus = section.next(section.state(x - h * D.col(i), s), k);
+      if (!plus.valid || !minus.valid) return it;
+      W.col(i) = (section.coordinates(plus.state) - section.coordinates(minus.state)) / (2 * h);
+    }
+    const Vector c = (W - D).completeOrthogonalDecomposition().solve(-F);
+    if (!c.allFinite()) return it;
+    s = section.state(x + D * c, s);
+  }
+  return it;
+}
+
 // DP^k at the fixed point, by central differences, restricted to Σ's tangent: perturbations
 // that keep the state on Σ (both angles together; the common velocity; with a compliant mesh or
 // after a bounce also the relative one) return to y± on Σ, and (P^k(y+) − P^k(y−)) =
@@ -290,9 +357,7 @@ double multiplier_from_jacobian(const ValidatedEffectModel& model, const Section
                                 int k) {
   const Vector star = section.coordinates(fixed);
   const double h = 1e-6 * scale_of(star);
-  std::vector<Vector> directions{Vector::Unit(4, 0) + Vector::Unit(4, 2), Vector::Unit(4, 1) + Vector::Unit(4, 3)};
-  if (model.effects().compliant() || fixed.dtheta_m != fixed.dtheta_L)
-    directions.push_back(Vector::Unit(4, 1) - Vector::Unit(4, 3));
+  const std::vector<Vector> directions = tangent_directions(model, fixed);
   const auto columns = static_cast<Eigen::Index>(directions.size());
   Eigen::MatrixXd Y(4, columns), Z(4, columns);
   for (Eigen::Index i = 0; i < columns; ++i) {
@@ -504,9 +569,9 @@ Iteration search_from(const ValidatedEffectModel& model, const Section& section,
     }
     return d.iteration;
   }
-  const Iteration it = iterate_periods(section, seed, options, velocity_scale);
+  const Iteration it = iterate_periods(model, section, seed, options, velocity_scale);
   if (it.converged()) {
-    cycle.method = "return map (Steffensen iteration)";
+    cycle.method = it.newton ? "return map (Newton's method)" : "return map (Steffensen iteration)";
     cycle.multiplier = multiplier_at(model, section, it.state, it.period_count);
     cycle.section_state = it.state;
     describe_cycle(model, section, it.state, it.period_count, cycle);

@@ -20,6 +20,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -68,8 +69,7 @@ const numeric::ValidatedEffectModel* model_of(const Parameters& p, const Effects
 Vector coordinates(const HybridState& s) { return {s.theta_m, s.dtheta_m, s.theta_L, s.dtheta_L}; }
 double size_of(const Vector& x) { return std::max(1.0, x.cwiseAbs().maxCoeff()); }
 
-// A long run's crossings of the limit-cycle search's section (recombinations onto face +1) and
-// the swing of θo over the run's last part.
+// A long run's crossings of the limit-cycle search's section (recombinations onto face +1).
 struct LongRun {
   SimulationResult result;
   std::vector<Vector> x;
@@ -80,7 +80,6 @@ LongRun run(const numeric::ValidatedEffectModel& m, const HybridState& start, do
   numeric::SimulationOptions o;
   o.t_end = t_end;
   o.max_events = 400000;
-  o.track_extremes = true;
   LongRun r;
   r.result = numeric::simulate_effects(m, start, o, {.general_engine = true, .extremes_after = extremes_after});
   for (const numeric::SimulationEvent& e : r.result.events)
@@ -116,16 +115,16 @@ Behaviour behaviour(const LongRun& r, double t_end) {
     b.text = std::string("settles (") + numeric::to_string(r.result.status) + ", " + std::to_string(n - third) + " late crossings)";
     return b;
   }
-  // The late swing of the crossings against the swing half-way: decaying by 10× is settling,
-  // growing by 10× is growth.
-  auto spread = [&](std::size_t from, std::size_t to) {
+  // The crossings' velocity (the motion's speed when the gap closes) late against half-way:
+  // decaying by 10× is settling, growing by 10× is growth.
+  auto speed = [&](std::size_t from, std::size_t to) {
     double s = 0;
-    for (std::size_t i = from + 1; i < to; ++i) s = std::max(s, (r.x[i] - r.x[i - 1]).cwiseAbs().maxCoeff());
+    for (std::size_t i = from; i < to; ++i) s = std::max(s, std::fabs(r.x[i](1)) + std::fabs(r.x[i](3)));
     return s;
   };
-  const double early = spread(half, (half + third) / 2 + 1), last = spread(n - std::min<std::size_t>(n - third, 12), n);
-  b.text = "crossing steps " + std::to_string(early) + " → " + std::to_string(last);
-  if (last < 1e-9 || last < 0.1 * early) return b;
+  const double early = speed(half, (half + third) / 2 + 1), last = speed(n - std::min<std::size_t>(n - third, 12), n);
+  b.text = "crossing speed " + std::to_string(early) + " → " + std::to_string(last);
+  if (last < 0.1 * early) return b;
   if (last > 10 * early) {
     b.kind = Behaviour::Grows;
     return b;
@@ -140,6 +139,12 @@ Behaviour behaviour(const LongRun& r, double t_end) {
   return b;
 }
 
+numeric::EffectLimitCycleOptions with_step(double step) {
+  numeric::EffectLimitCycleOptions o;
+  o.step = step;
+  return o;
+}
+
 std::string describe(const LimitCycle& c) {
   char text[400];
   std::snprintf(text, sizeof text, "%s k=%d ptp=%.6g amp=%.6g m=%.6g %s reason='%s'", numeric::to_string(c.status),
@@ -148,20 +153,30 @@ std::string describe(const LimitCycle& c) {
   return text;
 }
 
+// From the cycle's section state with both velocities moved by 1e-7 of the state: the deviation
+// from the section state after each of `periods` periods (empty when the run falls short).
+std::vector<double> deviations(const numeric::ValidatedEffectModel& m, const LimitCycle& c, int periods, LongRun& r) {
+  const int k = c.period_count;
+  const Vector star = coordinates(c.section_state);
+  HybridState start = c.section_state;
+  start.dtheta_m += 1e-7 * size_of(star), start.dtheta_L += 1e-7 * size_of(star);
+  r = run(m, start, (periods + 0.5) * c.period, 0);
+  std::vector<double> d;
+  if (r.x.size() < static_cast<std::size_t>(k * periods)) return d;
+  for (int j = 0; j < periods; ++j) d.push_back((r.x[static_cast<std::size_t>(k * (j + 1) - 1)] - star).cwiseAbs().maxCoeff());
+  return d;
+}
+
 // The checks of a reported cycle without delay, from its section state (see the file's head).
 // Returns a failure text, empty when the cycle is what the simulation shows.
 std::string check_cycle(const numeric::ValidatedEffectModel& m, const LimitCycle& c) {
   const int k = c.period_count;
   const Vector star = coordinates(c.section_state);
   const double scale = size_of(star), d0 = 1e-7 * scale;
-  HybridState start = c.section_state;
-  start.dtheta_m += d0, start.dtheta_L += d0;
   const int periods = 40;
-  const LongRun r = run(m, start, (periods + 0.5) * c.period, 0);
-  if (r.x.size() < static_cast<std::size_t>(k * periods)) return "the run has " + std::to_string(r.x.size()) + " crossings";
-  // Deviation after each period, while it is well above rounding and well below the cycle's size.
-  std::vector<double> d;
-  for (int j = 0; j < periods; ++j) d.push_back((r.x[static_cast<std::size_t>(k * (j + 1) - 1)] - star).cwiseAbs().maxCoeff());
+  LongRun r;
+  const std::vector<double> d = deviations(m, c, periods, r);
+  if (d.empty()) return "the run has " + std::to_string(r.x.size()) + " crossings";
   char text[300];
   const double m_abs = std::fabs(c.multiplier);
   if (c.stable) {
@@ -175,13 +190,12 @@ std::string check_cycle(const numeric::ValidatedEffectModel& m, const LimitCycle
       return text;
     }
   }
-  // Contraction: the geometric mean of the per-period ratios over the periods whose deviation is
-  // above 1e-11 of the state (rounding) and below 1e-3 (linear), against |m|.  The norm of a
+  // Contraction: the geometric mean of the per-period ratios over the first periods whose
+  // deviation stays above 1e-11 of the state (rounding) and below 1e-3 (linear), against |m|.  The norm of a
   // deviation is the dominant mode times a bounded factor c ∈ [1/10, 10] (subdominant and complex
   // modes), so over J periods the estimate's log is within ln(100)/J of ln|m|.
   std::size_t first = 0, last = 0;
-  for (std::size_t j = 0; j < d.size(); ++j)
-    if (d[j] > 1e-11 * scale && d[j] < 1e-3 * scale) last = j;
+  while (last + 1 < d.size() && d[last + 1] > 1e-11 * scale && d[last + 1] < 1e-3 * scale) ++last;
   if (last < 3 || m_abs < 1e-3) return "";
   const double J = static_cast<double>(last - first);
   const double measured = std::pow(d[last] / d[first], 1 / J);
@@ -228,12 +242,55 @@ TEST(Item02_PeriodK, CompliantMeshWithPeriodTwoIsFoundWithItsPeriodCount) {
 TEST(Item16_Reason, RestWithoutCoulombFrictionDoesNotNameACoulombDeadBand) {
   Effects e;
   e.saturation = 0.3;
-  Parameters p = parameters(1, 0.3, 0.5, 0.2, 0.5, 0.2, false);
+  const Parameters p = parameters(1, 0.2, 0.6, 0.48, 0.4, 0.32, false);  // case I
   const auto* m = model_of(p, e);
   ASSERT_NE(m, nullptr);
-  const LimitCycle c = numeric::find_limit_cycle(*m, {.step = 1});
+  const LimitCycle c = numeric::find_limit_cycle(*m, with_step(1));
   EXPECT_EQ(c.status, CycleStatus::None) << describe(c);
   EXPECT_EQ(c.reason.find("Coulomb"), std::string::npos) << describe(c);
+}
+
+// Item 3: compliant meshes the search called stable with multiplier −1.093 and −1.057 (main):
+// stable must mean |multiplier| < 1, and the multiplier must be the simulated contraction.
+TEST(Item03_Multiplier, CompliantMeshMultiplierIsTheSimulatedContraction) {
+  struct Case {
+    double K, b, Jm, Fm, JL, FL, stiffness, damping;
+  };
+  for (const Case& k : {Case{0.739971, 0.283841, 0.747198, 0.010877, 1.59677, 0.0881859, 34.2463, 0.188194},
+                        Case{1.78935, 0.281881, 0.78133, 0.063815, 0.516654, 0.0453679, 17.644, 0.189564}}) {
+    Effects e;
+    e.mesh_stiffness = k.stiffness, e.mesh_damping = k.damping;
+    const auto* m = model_of(parameters(k.K, k.b, k.Jm, k.Fm, k.JL, k.FL), e);
+    ASSERT_NE(m, nullptr);
+    const LimitCycle c = numeric::find_limit_cycle(*m);
+    ASSERT_EQ(c.status, CycleStatus::LimitCycle) << describe(c);
+    EXPECT_EQ(c.stable, std::fabs(c.multiplier) < 1) << describe(c);
+    const std::string failure = check_cycle(*m, c);
+    EXPECT_TRUE(failure.empty()) << failure << "; " << describe(c);
+  }
+}
+
+// Case V with restitution 0.4: the bounce leaves the two velocities independent, so the return
+// map's range is two-dimensional and the one-ray estimate (0.3132) was not its multiplier.
+TEST(Item03_Multiplier, RestitutionMultiplierIsTheSimulatedContraction) {
+  Effects e;
+  e.restitution = 0.4;
+  const auto* m = model_of(parameters(1, 0.3, 0.5, 0.1, 0.5, 0.3), e);
+  ASSERT_NE(m, nullptr);
+  const LimitCycle c = numeric::find_limit_cycle(*m, with_step(0.62));
+  ASSERT_EQ(c.status, CycleStatus::LimitCycle) << describe(c);
+  const std::string failure = check_cycle(*m, c);
+  EXPECT_TRUE(failure.empty()) << failure << "; " << describe(c);
+  // Sharper: the per-period ratio of the deviations at the last period whose deviation is above
+  // 1e-10 of the state (clear of rounding) tends to |m| geometrically as the other modes die, so
+  // it is within 3× its last change (+1e-3) of |m|.  (Simulated: 0.3414; the ray gave 0.3132.)
+  LongRun r;
+  const std::vector<double> d = deviations(*m, c, 20, r);
+  ASSERT_FALSE(d.empty());
+  std::size_t j = 2;
+  while (j + 1 < d.size() && d[j + 1] > 1e-10 * size_of(coordinates(c.section_state))) ++j;
+  const double ratio = d[j] / d[j - 1], change = std::fabs(ratio - d[j - 1] / d[j - 2]);
+  EXPECT_NEAR(c.multiplier, ratio, 3 * change + 1e-3) << describe(c);
 }
 
 // ------------------------------------------------------------------ the property test
@@ -265,12 +322,14 @@ TEST(Items01to03_Property, LimitCycleAnswersAgreeWithLongSimulations) {
   int failures = 0;
   for (const auto& kind : kinds) {
     const bool delayed = kind.front() == "delay";
-    for (int i = 0; i < (delayed ? cases_per_kind / 5 : cases_per_kind); ++i) {
+    // A delayed loop is integrated (method of steps), about 100× slower than a closed form.
+    for (int i = 0; i < (delayed ? std::min(2, cases_per_kind / 3) : cases_per_kind); ++i) {
       const Parameters p = draw.parameters(delayed ? i % 2 == 0 : i % 4 != 0);
       Effects e;
       std::string name;
       for (const std::string& k : kind) draw.add(k, e), name += (name.empty() ? "" : "+") + k;
       const double step = draw.uniform(0.3, 1.2);
+      const auto started = std::chrono::steady_clock::now();
       const auto* m = model_of(p, e);
       if (m == nullptr) {
         ++counts["refused by a gate"];
@@ -278,21 +337,30 @@ TEST(Items01to03_Property, LimitCycleAnswersAgreeWithLongSimulations) {
       }
       LimitCycle c;
       try {
-        c = numeric::find_limit_cycle(*m, {.step = step});
+        numeric::EffectLimitCycleOptions o = with_step(step);
+        if (delayed) o.max_cycles = 100;  // one continuous integrated run of 100 cycles per seed
+        c = numeric::find_limit_cycle(*m, o);
       } catch (const std::exception& x) {  // a work budget (exit 3 in the CLI): an answer, not a wrong one
         ++counts[std::string("work limit: ") + x.what()];
         continue;
       }
       ++counts[std::string(numeric::to_string(c.status)) + (c.period_count > 1 ? " k=" + std::to_string(c.period_count) : "")];
-      const double t_end = 400 * numeric::slowest_time_scale(p);
+      const double t_end = 120 * numeric::slowest_time_scale(p);
+      // The step response: needed to judge none, divergent and the delayed cycles (a cycle without
+      // delay is judged from its own section state, and unresolved claims nothing).
       LongRun r;
       try {
-        r = run(*m, numeric::effects_step_start(p, e, step), t_end, 0);
+        if (c.status != CycleStatus::Unresolved && (c.status != CycleStatus::LimitCycle || delayed))
+          r = run(*m, numeric::effects_step_start(p, e, step), t_end, 0);
       } catch (const std::exception& x) {
         ++counts[std::string("long run: ") + x.what()];
+        if (verbose)
+          std::printf("%s %d: long run: %s (%s; K=%.17g b=%.17g Jm=%.17g Fm=%.17g JL=%.17g FL=%.17g step=%.17g %s)\n",
+                      name.c_str(), i, x.what(), numeric::to_string(c.status), p.K, p.backlash, p.Jm, p.Fm, p.JL, p.FL,
+                      step, e.describe().c_str());
         continue;
       }
-      const Behaviour b = behaviour(r, t_end);
+      const Behaviour b = r.x.empty() && r.result.events.empty() ? Behaviour{} : behaviour(r, t_end);
       std::string failure;
       if (c.status == CycleStatus::LimitCycle) {
         if (!(std::isfinite(c.amplitude) && c.peak_to_peak > 0 && c.period > 0)) failure = "inconsistent cycle";
@@ -306,8 +374,8 @@ TEST(Items01to03_Property, LimitCycleAnswersAgreeWithLongSimulations) {
       if (c.status == CycleStatus::Divergent && b.kind != Behaviour::Grows) failure = "divergent, but the step response " + b.text;
       if (!failure.empty()) ++failures;
       if (verbose || !failure.empty())
-        std::printf("%s %d: K=%.6g b=%.6g Jm=%.6g Fm=%.6g JL=%.6g FL=%.6g %s step=%.6g effects=%s\n   %s\n   simulation: %s\n   %s\n",
-                    name.c_str(), i, p.K, p.backlash, p.Jm, p.Fm, p.JL, p.FL,
+        std::printf("%.2f s, %s %d: K=%.6g b=%.6g Jm=%.6g Fm=%.6g JL=%.6g FL=%.6g %s step=%.6g effects=%s\n   %s\n   simulation: %s\n   %s\n",
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(), name.c_str(), i, p.K, p.backlash, p.Jm, p.Fm, p.JL, p.FL,
                     p.measured_at == model::MeasuredAt::Load ? "load" : "motor", step, e.describe().c_str(),
                     describe(c).c_str(), b.text.c_str(), failure.empty() ? "ok" : ("FAIL: " + failure).c_str());
       EXPECT_TRUE(failure.empty()) << name << " " << i << ": " << failure;

@@ -73,7 +73,7 @@ struct LimitCycle {
   bool bounced = false;
   std::vector<double> other_fixed_points;     ///< further (e.g. unstable) cycles found
   // With effects (effects_limit_cycle.hpp):
-  std::string method = "half-cycle map";      ///< or "return map (Newton)", "return map (iteration)"
+  std::string method = "half-cycle map";      ///< or "return map (Steffensen iteration)", "return map (Newton's method)", …
   double residual = 0;                        ///< |P(s*) − s*| at the fixed point (section coordinates)
   int iterations = 0;                         ///< full cycles iterated before convergence
   double rest_error = 0;                      ///< "none" because the motion stops: θo − θR at rest
