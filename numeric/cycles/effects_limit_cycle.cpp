@@ -600,7 +600,7 @@ void without_cycle(const ValidatedEffectModel& model, const std::vector<Iteratio
            << (model.effects().coulomb() ? "the Coulomb dead band stops the motion; " : "") << "final error "
            << rest_error << ")";
   } else {
-    if (cycle.status != CycleStatus::Unresolved) reason << "no stable cycle: ";
+    if (cycle.status == CycleStatus::None) reason << "no stable cycle: ";
     for (std::size_t i = 0; i < outcomes.size(); ++i) reason << (i ? "; " : "") << outcomes[i];
   }
   if (cycle.status == CycleStatus::None && p.measured_at == model::MeasuredAt::Motor)
