@@ -405,6 +405,8 @@ std::string Cycle::json() const {
                      {"other_fixed_points", cycle.other_fixed_points},
                      {"effects", detail::effects_json(effects)},
                      {"method", cycle.method}};
+  // A cycle that crosses the return map's section k > 1 times per period (docs/design.md).
+  if (ok && cycle.period_count > 1) out["period_count"] = cycle.period_count;
   if (with_effects) {
     out["iterations"] = cycle.iterations;
     out["residual"] = value(cycle.residual);
@@ -422,10 +424,13 @@ std::string Cycle::json() const {
 std::string Cycle::text() const {
   std::string out;
   if (!found()) {
-    appendf(out, "%s: no limit cycle: %s\n", case_id.c_str(), cycle.reason.c_str());
+    appendf(out, "%s: %s: %s\n", case_id.c_str(),
+            cycle.status == numeric::CycleStatus::Unresolved ? "limit cycle unresolved" : "no limit cycle",
+            cycle.reason.c_str());
     return out;
   }
-  appendf(out, "%s: %s limit cycle (%s; effects: %s)\n", case_id.c_str(), cycle.stable ? "stable" : "unstable",
+  const std::string kind = cycle.period_count > 1 ? "period-" + std::to_string(cycle.period_count) + " cycle" : "limit cycle";
+  appendf(out, "%s: %s %s (%s; effects: %s)\n", case_id.c_str(), cycle.stable ? "stable" : "unstable", kind.c_str(),
           cycle.method.c_str(), effects.describe().c_str());
   appendf(out, "  separation velocity  %.12f\n  multiplier (P')      %.9f\n  period               %.9f\n",
           cycle.separation_velocity, cycle.multiplier, cycle.period);

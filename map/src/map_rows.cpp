@@ -68,7 +68,7 @@ std::string map_csv_row(const MapRow& r) {
   const numeric::LimitCycle& c = r.row.cycle;
   for (const double v : {c.peak_to_peak, c.amplitude, c.period, c.separation_velocity, c.multiplier})
     out += ',', append_number(out, cycle ? v : NAN);
-  const bool computed = status == "limit_cycle" || status == "none" || status == "divergent";
+  const bool computed = status == "limit_cycle" || status == "none" || status == "divergent" || status == "unresolved";
   out += ',', append_number(out, computed ? r.row.settle.time : NAN);
   out += ',' + (computed ? r.row.settle.status : std::string());
   return out + "\n";

@@ -14,18 +14,22 @@
 
 namespace backlash::map::detail {
 
-/// The statuses a record stores as a code (status_of's texts; anything else is "other").
+/// The statuses a record stores as a code (status_of's texts; anything else is "other");
+/// "unresolved" came last, after "other", so that the earlier codes kept their values.
 inline const std::vector<std::string>& map_status_names() {
   static const std::vector<std::string> names = {"limit_cycle", "none",  "divergent", "unvalidated",
-                                                 "refused",     "error", "other"};
+                                                 "refused",     "error", "other",     "unresolved"};
   return names;
 }
+inline constexpr std::int8_t map_status_other = 6;
 inline std::int8_t map_status_code(const std::string& status) {
   const auto& names = map_status_names();
-  for (std::size_t k = 0; k + 1 < names.size(); ++k)
-    if (names[k] == status) return static_cast<std::int8_t>(k);
-  return static_cast<std::int8_t>(names.size() - 1);
+  for (std::size_t k = 0; k < names.size(); ++k)
+    if (names[k] == status && k != map_status_other) return static_cast<std::int8_t>(k);
+  return map_status_other;
 }
+/// True for the statuses of a point whose limit-cycle search ran (its settle time is computed).
+inline bool map_status_searched(std::int64_t code) { return code <= 2 || code == 7; }
 
 /// A record: index (int64), status code (int64), then doubles: the d varied values, the
 /// parameters of points.csv (numeric::point_column_names: the structure and every effect
@@ -45,7 +49,7 @@ inline void append_record(std::string& out, const MapRow& r) {
   out.append(reinterpret_cast<const char*>(head), sizeof head);
   const numeric::Parameters& p = r.row.point.parameters;
   const numeric::Effects& e = r.row.point.effects;
-  const bool cycle = head[1] == 0, computed = head[1] <= 2;
+  const bool cycle = head[1] == 0, computed = map_status_searched(head[1]);
   const numeric::LimitCycle& c = r.row.cycle;
   std::vector<double> v = r.x;
   for (const double x : numeric::point_column_values(p, e)) v.push_back(x);

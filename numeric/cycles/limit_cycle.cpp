@@ -31,6 +31,7 @@ const char* to_string(CycleStatus status) {
     case CycleStatus::LimitCycle: return "limit_cycle";
     case CycleStatus::None: return "none";
     case CycleStatus::Divergent: return "divergent";
+    case CycleStatus::Unresolved: return "unresolved";
   }
   return "none";
 }

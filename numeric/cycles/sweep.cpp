@@ -78,6 +78,7 @@ const char* to_string(SweepStatus status) {
     case SweepStatus::Unvalidated: return "unvalidated";
     case SweepStatus::Refused: return "refused";
     case SweepStatus::Error: return "error";
+    case SweepStatus::Unresolved: return "unresolved";
   }
   return "error";
 }
@@ -89,6 +90,7 @@ SweepStatus sweep_status(CycleStatus status) {
     case CycleStatus::LimitCycle: return SweepStatus::LimitCycle;
     case CycleStatus::None: return SweepStatus::None;
     case CycleStatus::Divergent: return SweepStatus::Divergent;
+    case CycleStatus::Unresolved: return SweepStatus::Unresolved;
   }
   return SweepStatus::Error;
 }

@@ -300,6 +300,8 @@ void bind_cycle(py::module_& m) {
       .def_property_readonly("peak_to_peak_motor", cycle_value(&numeric::LimitCycle::peak_to_peak_motor))
       .def_property_readonly("peak_to_peak_load", cycle_value(&numeric::LimitCycle::peak_to_peak_load))
       .def_property_readonly("period", cycle_value(&numeric::LimitCycle::period))
+      // k of a period-k cycle (crossings of the return map's section per period); 0 without a cycle.
+      .def_property_readonly("period_count", [](const api::Cycle& c) { return c.found() ? c.cycle.period_count : 0; })
       .def_property_readonly("separation_velocity", cycle_value(&numeric::LimitCycle::separation_velocity))
       .def_property_readonly("multiplier", cycle_value(&numeric::LimitCycle::multiplier))
       .def_property_readonly("half_map_derivative", cycle_value(&numeric::LimitCycle::half_map_derivative))

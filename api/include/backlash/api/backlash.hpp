@@ -241,7 +241,9 @@ struct Cycle {
   numeric::Parameters parameters;
   numeric::Effects effects;
   numeric::LimitCycle cycle;
-  /// "limit_cycle", "none" (reason in cycle.reason) or "divergent": the CLI's `status`.
+  /// "limit_cycle" (a period-k cycle when cycle.period_count = k > 1), "none" (the motion
+  /// settles; reason in cycle.reason), "divergent" or "unresolved" (the search could not
+  /// decide; reason in cycle.reason): the CLI's `status`.
   /// The one place the numeric layer's status is turned into text.
   std::string status() const;
   bool found() const { return cycle.status == numeric::CycleStatus::LimitCycle; }

@@ -5,16 +5,20 @@
 // return map (the next separation leaving that face).  No symmetry is assumed,
 // so a torque offset, which breaks the odd symmetry about θR, is handled alike.
 //   1. From seeds — the step experiment, and free flights leaving face −1 on the
-//      nominal separation line at several velocities — P is iterated until the
-//      section state stops moving (a stable cycle), the motion comes to rest (with
-//      Coulomb friction: a dead band) or grows without bound.
-//   2. Without delay the fixed point is polished by Newton's method on
-//      F(s) = P(s) − s in the section's coordinates — (θo, θ̇o) for rigid gears,
-//      (θm, θ̇m, θL, θ̇L) with a compliant mesh — with a central-difference
-//      Jacobian; the multiplier is the largest eigenvalue (in modulus) of DP (the
-//      others vanish: P's range is Σ).  With a delay the state is a whole history:
-//      the cycle is the converged iteration and the multiplier the ratio of
-//      successive steps of the iteration.
+//      nominal separation line at several velocities — P is iterated (Steffensen)
+//      until the section state stops moving (a stable cycle), the motion comes to
+//      rest (with Coulomb friction: a dead band) or grows without bound; when it
+//      does not settle, P², P³, P⁴ (a period-k cycle is a fixed point of P^k), then
+//      Newton's method on F(s) = P^k(s) − s along Σ with a central-difference
+//      Jacobian (slow or unstable cycles; a stable one preferred).  Nothing settled:
+//      the status unresolved, never none.
+//   2. Without delay the multiplier is the eigenvalue of largest modulus of DP^k
+//      restricted to Σ (central differences; its modulus for a complex pair), or the
+//      one-ray Richardson estimate when that agrees with it to 1e-3.  With a delay
+//      the state is a whole history: the cycle is the converged iteration of one
+//      continuous run (period k when the crossings repeat every k), the multiplier
+//      the ratio of successive steps.  stable ⇔ |multiplier| < 1; a cycle whose
+//      figures are not finite or beyond the divergence bound is not reported.
 //   3. On the cycle one period is simulated with exact extremes: amplitude
 //      max|θo − θR|, peak-to-peak of θo, θm, θL, period, separation velocity (NaN
 //      for a cycle without a separation: with restitution the bodies can bounce from

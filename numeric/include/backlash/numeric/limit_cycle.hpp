@@ -42,10 +42,13 @@ double stability_constant(const Parameters& p, double theta_o, double dtheta_o);
 /// exp(−π a/ω): the factor by which the principal-branch C jumps across θo = θR.
 double stability_constant_jump(const Parameters& p);
 
-/// What a limit-cycle search found: a cycle, none (the reason says why), or an oscillation that
-/// grows instead of settling (g(v) > v wherever sampled).
-enum class CycleStatus { LimitCycle, None, Divergent };
-/// "limit_cycle", "none", "divergent": the text of the CLI's and the CSV's `status`.
+/// What a limit-cycle search found: a cycle, none (the motion settles; the reason says how), an
+/// oscillation that grows instead of settling (g(v) > v wherever sampled), or unresolved: the
+/// search could not decide (with effects: the return map settled at no period from 1 to 4, a
+/// simulation stopped early, or the cycle it converged to had inconsistent figures) — never a
+/// claim that the motion settles (docs/design.md, "limit-cycle").
+enum class CycleStatus { LimitCycle, None, Divergent, Unresolved };
+/// "limit_cycle", "none", "divergent", "unresolved": the text of the CLI's and the CSV's `status`.
 const char* to_string(CycleStatus status);
 std::ostream& operator<<(std::ostream& out, CycleStatus status);  ///< as to_string (test messages)
 
@@ -53,10 +56,12 @@ struct LimitCycle {
   CycleStatus status = CycleStatus::None;
   std::string reason;           ///< for "none" and "divergent": what the search computed, in words
   double separation_velocity = 0;   ///< v*
-  double multiplier = 0;            ///< P'(v*) = g'(v*)² of the full return map
+  double multiplier = 0;            ///< P'(v*) = g'(v*)² of the full return map (with effects: of P^k,
+                                    ///< its eigenvalue of largest modulus; stable ⇔ |multiplier| < 1)
   double half_map_derivative = 0;   ///< g'(v*)
   bool stable = false;
-  double period = 0;
+  double period = 0;                ///< [s], the whole period (all k crossings of the section)
+  int period_count = 1;             ///< k: crossings of the return map's section per period (period-k cycle)
   double amplitude = 0;             ///< max |θo − θR|
   double peak_to_peak = 0;          ///< of θo
   double peak_to_peak_motor = 0, peak_to_peak_load = 0;
@@ -68,7 +73,7 @@ struct LimitCycle {
   bool bounced = false;
   std::vector<double> other_fixed_points;     ///< further (e.g. unstable) cycles found
   // With effects (effects_limit_cycle.hpp):
-  std::string method = "half-cycle map";      ///< or "return map (Newton)", "return map (iteration)"
+  std::string method = "half-cycle map";      ///< or "return map (Steffensen iteration)", "return map (Newton's method)", …
   double residual = 0;                        ///< |P(s*) − s*| at the fixed point (section coordinates)
   int iterations = 0;                         ///< full cycles iterated before convergence
   double rest_error = 0;                      ///< "none" because the motion stops: θo − θR at rest

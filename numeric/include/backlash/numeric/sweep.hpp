@@ -46,8 +46,8 @@ struct SweepPoint {
 /// A sweep point's outcome: the limit-cycle search's (CycleStatus), or why it was not searched:
 /// unvalidated (its evaluators failed their gate), refused (double precision cannot handle its
 /// parameters: scales.hpp), error (an exception, its text in the reason).
-enum class SweepStatus { LimitCycle, None, Divergent, Unvalidated, Refused, Error };
-/// "limit_cycle", "none", "divergent", "unvalidated", "refused", "error": the CSV's `status`.
+enum class SweepStatus { LimitCycle, None, Divergent, Unvalidated, Refused, Error, Unresolved };
+/// "limit_cycle", "none", "divergent", "unvalidated", "refused", "error", "unresolved": the CSV's `status`.
 const char* to_string(SweepStatus status);
 std::ostream& operator<<(std::ostream& out, SweepStatus status);  ///< as to_string (test messages)
 /// The row status of a point whose search ran.
