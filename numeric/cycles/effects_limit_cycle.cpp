@@ -260,22 +260,31 @@ Iteration iterate_periods(const ValidatedEffectModel& model, const Section& sect
     it = next;
   }
   if (it.verdict == Verdict::Unresolved && it.cycles > 0) stops.push_back(it.state);
-  // A stable cycle first (the iterations' attractor, converging slowly); else the first
-  // unstable one Newton found.
+  // A stable cycle (the iterations' attractor, converging slowly) is the answer.  An unstable
+  // one is not: the motion leaves it for an attractor the search has not resolved, so it is
+  // only named in the reason (docs/design.md, "The limit-cycle contract").
   std::optional<Iteration> unstable;
+  double unstable_multiplier = NAN;
   for (std::size_t j = 0; j < stops.size() && it.verdict == Verdict::Unresolved && it.cycles > 0; ++j) {
     const int k = static_cast<int>(j) + 1;
     const Iteration polished = newton(model, section, stops[j], k);
     if (!polished.converged()) continue;
-    if (std::fabs(multiplier_from_jacobian(model, section, polished.state, k)) < 1) it = polished;
-    else if (!unstable) unstable = polished;
+    const double m = multiplier_from_jacobian(model, section, polished.state, k);
+    if (std::fabs(m) < 1) it = polished;
+    else if (!unstable) unstable = polished, unstable_multiplier = m;
   }
-  if (it.verdict == Verdict::Unresolved && unstable) it = *unstable;
   if (it.converged()) it.period_count = minimal_period(section, it.state, it.period_count);
-  if (it.verdict == Verdict::Unresolved && it.cycles > 0)
+  if (it.verdict == Verdict::Unresolved && it.cycles > 0) {
     it.outcome = "the return map did not settle within " + std::to_string(o.max_cycles) +
                  " returns at any period from 1 to " + std::to_string(max_period) +
                  " (a slowly converging, quasi-periodic or chaotic motion)";
+    if (unstable) {
+      char text[160];
+      std::snprintf(text, sizeof text, "; Newton's method finds an unstable period-%d cycle there (multiplier %.6g), which the motion leaves",
+                    minimal_period(section, unstable->state, unstable->period_count), unstable_multiplier);
+      it.outcome += text;
+    }
+  }
   return it;
 }
 
