@@ -2,6 +2,8 @@
 // through the built CLI (exit codes, the reason in one line, time and peak memory under a
 // kill timeout, so that a hang fails instead of hanging) and, for the odeint gate, the library.
 // BACKLASH_CLI_UNDER_TEST=path runs the CLI tests against another binary (e.g. main's).
+#include "scratch_folder.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -36,25 +38,11 @@ struct Child {
 };
 
 const fs::path& folder() {
-  static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("backlash-effects-limits-" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = backlash::testing::scratch_folder("effects-limits");
   return dir;
 }
 
-struct FolderRemoval {
-  ~FolderRemoval() {
-    std::error_code ignored;
-    fs::remove_all(folder(), ignored);
-  }
-} folder_removal;
-
-std::string contents(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+std::string contents(const fs::path& file) { return backlash::testing::slurp(file); }
 
 /// `backlash ARGS...` without a shell, killed after `timeout_s`; stdout, stderr kept unless
 /// `keep_stdout` is false (a long CSV goes to /dev/null).

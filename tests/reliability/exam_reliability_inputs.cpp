@@ -11,6 +11,8 @@
 #include "backlash/api/backlash.hpp"
 #include "backlash/model/case_spec.hpp"
 
+#include "scratch_folder.hpp"
+
 #include <gtest/gtest.h>
 
 #include <sys/resource.h>
@@ -40,26 +42,9 @@ struct CliRun {
   double cpu_seconds = 0;  ///< the child's user + system time
 };
 
-fs::path scratch() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::temp_directory_path() / ("backlash-inputs-" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
+fs::path scratch() { return backlash::testing::scratch_folder("inputs"); }
 
-struct ScratchCleanup {
-  ~ScratchCleanup() {
-    std::error_code ignored;
-    fs::remove_all(fs::temp_directory_path() / ("backlash-inputs-" + std::to_string(::getpid())), ignored);
-  }
-} cleanup;
-
-std::string slurp(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+using backlash::testing::slurp;
 
 /// Runs `backlash ARGUMENTS`, at most `limit` seconds of wall time (`timeout` ends it with 124)
 /// and 8 MiB per output file (ulimit -f: a run that writes without end is killed by SIGXFSZ).

@@ -4,6 +4,8 @@
 // one map run per --out (14), sloppy map/sweep flags refused (16).  Test names carry the item.
 // The binary is BACKLASH_CLI (the build's); the environment variable BACKLASH_CLI_UNDER_TEST
 // points them at another one (how each was seen failing on the old code).
+#include "scratch_folder.hpp"
+
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
@@ -29,31 +31,14 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-fs::path scratch() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::temp_directory_path() / ("backlash-outputs-" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
-
-struct ScratchCleanup {
-  ~ScratchCleanup() {
-    std::error_code ignored;
-    fs::remove_all(fs::temp_directory_path() / ("backlash-outputs-" + std::to_string(::getpid())), ignored);
-  }
-} cleanup;
+fs::path scratch() { return backlash::testing::scratch_folder("outputs"); }
 
 std::string cli() {
   const char* other = std::getenv("BACKLASH_CLI_UNDER_TEST");
   return other && *other ? other : BACKLASH_CLI;
 }
 
-std::string slurp(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+using backlash::testing::slurp;
 
 int lines(const std::string& text) { return static_cast<int>(std::count(text.begin(), text.end(), '\n')); }
 

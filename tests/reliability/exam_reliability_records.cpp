@@ -3,6 +3,8 @@
 // a record with a gap and an import whose write fails (15), the progress of a long discrepancy
 // run (17).  Test names carry the item number.  BACKLASH_RECORDS_CLI, when set, runs another
 // binary (e.g. main's, to see each test fail there).
+#include "scratch_folder.hpp"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -27,31 +29,14 @@ struct CliRun {
   std::string out, err;
 };
 
-fs::path scratch() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::temp_directory_path() / ("backlash-records-" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
-  return dir;
-}
-
-struct ScratchCleanup {
-  ~ScratchCleanup() {
-    std::error_code ignored;
-    fs::remove_all(fs::temp_directory_path() / ("backlash-records-" + std::to_string(::getpid())), ignored);
-  }
-} cleanup;
+fs::path scratch() { return backlash::testing::scratch_folder("records"); }
 
 std::string cli() {
   const char* other = std::getenv("BACKLASH_RECORDS_CLI");
   return other && *other ? other : BACKLASH_CLI;
 }
 
-std::string slurp(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
+using backlash::testing::slurp;
 
 /// Runs `PREFIX backlash ARGUMENTS` through /bin/sh, stdout and stderr to files.
 CliRun run(const std::string& arguments, const std::string& prefix = "") {
