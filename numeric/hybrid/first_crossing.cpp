@@ -2,6 +2,7 @@
 
 #include "hybrid/balancing.hpp"
 
+#include <boost/container/small_vector.hpp>
 #include <boost/math/tools/roots.hpp>
 
 #include <cmath>
@@ -14,7 +15,7 @@ namespace backlash::numeric {
 namespace {
 
 struct Sample {
-  double t, w, w1, w2, rate_norm;  // w and its first two derivatives, ‖D x'(t)‖∞
+  double t, w, w1, w2, rate_norm, x_norm;  // w and its first two derivatives, ‖D x'(t)‖∞, ‖x(t)‖∞
 };
 
 // The logarithmic norm μ∞(A) = max_i (a_ii + Σ_{j≠i} |a_ij|): ‖e^{At}‖∞ ≤ e^{μ∞(A) t} for t ≥ 0
@@ -43,51 +44,68 @@ double log_norm(const SmallMatrix& A) {
 // and event time, stays exactly the unscaled one.
 constexpr double kBalanceGain = 16;
 
-struct Witness {
-  const LinearWitness& lw;
-  SmallRow eA, eA2, eA3;
-  SmallVector scale;  // D: the bounds are in ‖D·‖∞
-  double eAc, eA2c, mu_A, norm_c, norm_eA2, norm_eA3;
+// The relative size allowed for the rounding of the closed forms and of the samples' arithmetic
+// when an interval is judged too long to decide from its left end (must_halve): far above the
+// few ulps (times the closed forms' cancellation) they carry, so that the judgement never comes
+// near the tests it anticipates.
+constexpr double kSampleNoise = 1e-6;
 
-  explicit Witness(const LinearWitness& w) : lw(w) {
-    eA = w.e * w.A;
-    eA2 = eA * w.A;
-    eA3 = eA2 * w.A;
-    eAc = eA.dot(w.c);
-    eA2c = eA2.dot(w.c);
-    mu_A = log_norm(w.A);
-    scale = SmallVector::Ones(w.A.rows());
-    if (mu_A > 0) {
-      const SmallVector d = detail::balancing(w.A);
-      const SmallMatrix balanced = d.asDiagonal() * w.A * d.cwiseInverse().asDiagonal();
-      const double mu_balanced = log_norm(balanced);
-      if (mu_balanced * kBalanceGain < mu_A) {
-        scale = d;
-        mu_A = mu_balanced;
-      }
-    }
-    norm_c = w.c.cwiseAbs().maxCoeff();
-    norm_eA2 = eA2.cwiseQuotient(scale.transpose()).cwiseAbs().sum();
-    norm_eA3 = eA3.cwiseQuotient(scale.transpose()).cwiseAbs().sum();
-  }
+// A witness on a mode, sampled through one closed-form evaluation per point.
+class Sampler {
+ public:
+  Sampler(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample, double level)
+      : m_(mode), sample_(sample), level_(level) {}
+
+  const WitnessMode& mode() const { return m_; }
 
   // ‖D z‖∞
-  double rate_norm(const SmallVector& z) const { return z.cwiseProduct(scale).cwiseAbs().maxCoeff(); }
+  double rate_norm(const SmallVector& z) const { return z.cwiseProduct(m_.scale).cwiseAbs().maxCoeff(); }
 
   Sample at(double t) const {
-    const SmallVector x = lw.state(t);
-    const double w = (lw.value ? lw.value(t) : lw.e.dot(x)) - lw.level;
-    const double w1 = eA.dot(x) + lw.e.dot(lw.c);
-    const double w2 = eA2.dot(x) + eAc;
-    const SmallVector z = lw.A * x + lw.c;  // x' obeys z' = A z
-    return {t, w, w1, w2, rate_norm(z)};
+    const WitnessSample s = sample_(t);
+    const double w = s.value - level_;
+    const double w1 = m_.eA.dot(s.x) + m_.ec;
+    const double w2 = m_.eA2.dot(s.x) + m_.eAc;
+    const SmallVector z = m_.A * s.x + m_.c;  // x' obeys z' = A z
+    return {t, w, w1, w2, rate_norm(z), s.x.cwiseAbs().maxCoeff()};
   }
+  double value(double t) const { return sample_(t).value - level_; }
 
   // sup |w'''| on [a.t, a.t + h]: w''' = eA² z = (eA² D⁻¹)(D z) and ‖D z(t)‖∞ ≤
   // e^{μ∞(DAD⁻¹)(t−a)} ‖D z(a)‖∞ (the supremum of e^{μ s} over s ∈ [0, h] is 1 when μ ≤ 0).
   double third_bound(const Sample& a, double h) const {
-    return norm_eA2 * std::exp(std::max(0.0, mu_A) * h) * a.rate_norm;
+    return m_.norm_eA2 * std::exp(std::max(0.0, m_.mu_A) * h) * a.rate_norm;
   }
+
+  // Whether [a.t, a.t + h] is certain to be halved by the search below — neither excluded nor
+  // certified monotone, whatever w does at its right end — judged from its left end alone.  With
+  // E = e^{μ⁺h} and ‖D z‖ ≤ E ‖D z(a)‖ on the interval: |w'| ≤ U1 = ‖eD⁻¹‖₁ E ‖D z(a)‖∞ and
+  // |w(b)| ≤ |w(a)| + h U1, while the search's own bounds are at least M2 ≥ h M3/2 and
+  // M1 ≥ h² M3/4 (M3 as third_bound).  Monotone needs |w'(a)| + |w'(b)| > h M2, excluded needs
+  // |w(a)| + |w(b)| > h M1: both are out of reach when twice the upper bounds (plus the samples'
+  // rounding, kSampleNoise of their scale) stay below those products.  Never for an interval the
+  // search would decide by its length (min_interval) or with a caller's third-derivative bound.
+  // Where e^{μh} overflows the search's own bounds are infinite (or NaN) and it halves too.
+  bool must_halve(const Sample& a, double h, double min_length) const {
+    if (!(h >= min_length)) return false;
+    const double E = std::exp(std::max(0.0, m_.mu_A) * h);
+    const double M3 = m_.norm_eA2 * E * a.rate_norm;
+    if (!(M3 < INFINITY)) return true;  // the search's M2 and M1 are then infinite or NaN: no test passes
+    const double rate_bound = a.rate_norm + kSampleNoise * m_.norm_A * a.x_norm;  // rounding of z = A x + c
+    const double U1 = m_.norm_e * E * rate_bound;
+    const double x_bound = a.x_norm + h * E * rate_bound * m_.inverse_scale;  // ≥ ‖x(t)‖∞ on the interval
+    const double noise1 = kSampleNoise * (m_.norm_eA * x_bound + std::fabs(m_.ec));
+    const double noise0 = kSampleNoise * (std::fabs(level_) + std::fabs(a.w) + m_.norm_e_plain * x_bound);
+    const double monotone_reach = h * (0.5 * (h * M3));
+    const double exclusion_reach = h * (0.5 * (h * (0.5 * (h * M3))));
+    return 2 * (std::fabs(a.w1) + U1 + noise1) < monotone_reach &&
+           2 * (2 * std::fabs(a.w) + h * U1 + noise0) < exclusion_reach;
+  }
+
+ private:
+  const WitnessMode& m_;
+  FunctionRef<WitnessSample(double)> sample_;
+  double level_;
 };
 
 bool same_sign(double x, double y) { return (x > 0 && y > 0) || (x < 0 && y < 0); }
@@ -108,18 +126,122 @@ bool quadratic_resolved(double second, double third, double time_unit) {
   return std::fabs(second) > std::fabs(third) * kStartTimeUncertainty * time_unit;
 }
 
+// An interval of the search; a lazy end (known = false) has only its time, sampled when needed.
+struct Interval {
+  Sample a, b;
+  bool a_known, b_known;
+};
+
+Sample lazy(double t) { return {t, 0, 0, 0, 0, 0}; }
+
+// The root of w in [a, b] (a sign change, w monotone there or the interval at the resolution).
+double root_in(const Sampler& W, const Sample& a, const Sample& b, const CrossingOptions& options) {
+  const auto f = [&W](double t) { return W.value(t); };
+  boost::uintmax_t iterations = 200;
+  const double tolerance = options.time_tolerance, unit = W.mode().time_unit;
+  const auto root = boost::math::tools::toms748_solve(
+      f, a.t, b.t, a.w, b.w,
+      [tolerance, unit](double lo, double hi) { return hi - lo <= tolerance * std::max(unit, std::fabs(hi)); },
+      iterations);
+  return 0.5 * (root.first + root.second);
+}
+
+// Depth-first, left half first: a stack of intervals whose top is the leftmost (inline storage:
+// no allocation unless the bisection goes deeper than 96 levels).
+std::optional<Crossing> search(const Sampler& W, const std::function<double(double, double)>* third_derivative_bound,
+                               double t_begin, double t_end, const CrossingOptions& options) {
+  if (!(t_end > t_begin)) return std::nullopt;
+  const double min_length = options.min_interval * W.mode().time_unit;
+  long examined = 0;
+  boost::container::small_vector<Interval, 96> stack;
+  stack.push_back({W.at(t_begin), lazy(t_end), true, false});
+  while (!stack.empty()) {
+    if (++examined > options.max_intervals)
+      throw SearchBudgetExhausted("the certified event search exhausted its budget of " +
+                                  std::to_string(options.max_intervals) + " intervals");
+    Interval i = stack.back();
+    stack.pop_back();
+    Sample& a = i.a;
+    Sample& b = i.b;
+    if (!i.a_known) a = W.at(a.t);
+    const double h = b.t - a.t;
+    const bool halve = !third_derivative_bound && std::isfinite(a.w) && W.must_halve(a, h, min_length);
+    if (!halve && !i.b_known) b = W.at(b.t);
+    if (!std::isfinite(a.w) || (!halve && !std::isfinite(b.w))) throw std::runtime_error("first_crossing: non-finite witness");
+    if (a.w == 0 && a.t > t_begin) return Crossing{a.t, false, examined};
+    if (halve) {
+      const double m = a.t + 0.5 * h;
+      stack.push_back({lazy(m), b, false, i.b_known});
+      stack.push_back({a, lazy(m), true, false});
+      continue;
+    }
+    const double M3 = third_derivative_bound ? (*third_derivative_bound)(a.t, b.t) : W.third_bound(a, h);
+    const double M2 = 0.5 * (std::fabs(a.w2) + std::fabs(b.w2) + h * M3);
+    const double M1 = 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) + h * M2);
+    const bool sign_change = !same_sign(a.w, b.w);
+    if (!sign_change && std::fabs(a.w) + std::fabs(b.w) > h * M1) continue;  // excluded
+    const bool monotone = same_sign(a.w1, b.w1) && 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) - h * M2) > 0;
+    if (monotone || h < min_length) {
+      if (sign_change) {
+        if (b.w == 0) return Crossing{b.t, false, examined};
+        return Crossing{root_in(W, a, b, options), false, examined};
+      }
+      if (monotone) continue;  // monotone without a sign change: no root
+      // Uncertified down to the resolution: the witness touches the level here.
+      return Crossing{std::fabs(a.w) <= std::fabs(b.w) ? a.t : b.t, true, examined};
+    }
+    const Sample m = W.at(a.t + 0.5 * h);
+    stack.push_back({m, b, true, true});
+    stack.push_back({a, m, true, true});
+  }
+  return std::nullopt;
+}
+
+// The LinearWitness form as a sampler: x = state(t), value = value(t) or eᵀx.
+WitnessSample sample_of(const LinearWitness& witness, double t) {
+  WitnessSample s{witness.state(t), 0};
+  s.value = witness.value ? witness.value(t) : witness.e.dot(s.x);
+  return s;
+}
+
 }  // namespace
 
-std::optional<double> certified_departure(const LinearWitness& witness, double noise) {
-  const Witness W(witness);
-  const SmallVector x0 = witness.state(0);
-  const double z0 = W.rate_norm(witness.A * x0 + witness.c);  // ‖D x'(0)‖∞, with ‖D x'(t)‖∞ ≤ e^{μ t} z0
-  const double second = W.eA.dot(witness.A * x0 + witness.c);           // w''(0) = eA x'(0)
-  const double third = W.eA2.dot(witness.A * x0 + witness.c);           // w'''(0) = eA² x'(0)
+WitnessMode::WitnessMode(const SmallMatrix& A_, const SmallVector& c_, const SmallRow& e_, double time_unit_)
+    : A(A_), c(c_), e(e_), time_unit(time_unit_) {
+  eA = e * A;
+  eA2 = eA * A;
+  eA3 = eA2 * A;
+  ec = e.dot(c);
+  eAc = eA.dot(c);
+  eA2c = eA2.dot(c);
+  mu_A = log_norm(A);
+  scale = SmallVector::Ones(A.rows());
+  if (mu_A > 0) {
+    const SmallVector d = detail::balancing(A);
+    const SmallMatrix balanced = d.asDiagonal() * A * d.cwiseInverse().asDiagonal();
+    const double mu_balanced = log_norm(balanced);
+    if (mu_balanced * kBalanceGain < mu_A) {
+      scale = d;
+      mu_A = mu_balanced;
+    }
+  }
+  norm_e = e.cwiseQuotient(scale.transpose()).cwiseAbs().sum();
+  norm_eA2 = eA2.cwiseQuotient(scale.transpose()).cwiseAbs().sum();
+  norm_eA3 = eA3.cwiseQuotient(scale.transpose()).cwiseAbs().sum();
+  norm_e_plain = e.cwiseAbs().sum();
+  norm_eA = eA.cwiseAbs().sum();
+  norm_A = (scale.asDiagonal() * A).cwiseAbs().rowwise().sum().maxCoeff();
+  inverse_scale = scale.cwiseInverse().maxCoeff();
+}
+
+std::optional<double> certified_departure(const WitnessMode& W, const SmallVector& x0, double noise) {
+  const double z0 = (W.A * x0 + W.c).cwiseProduct(W.scale).cwiseAbs().maxCoeff();  // ‖D x'(0)‖∞, ‖D x'(t)‖∞ ≤ e^{μ t} z0
+  const double second = W.eA.dot(W.A * x0 + W.c);   // w''(0) = eA x'(0)
+  const double third = W.eA2.dot(W.A * x0 + W.c);   // w'''(0) = eA² x'(0)
   const double scale = std::max(std::fabs(second), 1e-300);
   const double growth = std::max(0.0, W.mu_A);  // ‖D x'(t)‖∞ ≤ e^{μ∞(DAD⁻¹) t} z0
   // w'' dominant: |w''(0)| > t0 sup|w'''|, sup|w'''| ≤ ‖eA²‖ e^{μ t0} z0.
-  if (std::fabs(second) > 1e-12 * std::max(1.0, z0) && quadratic_resolved(second, third, witness.time_unit)) {
+  if (std::fabs(second) > 1e-12 * std::max(1.0, z0) && quadratic_resolved(second, third, W.time_unit)) {
     double t0 = std::sqrt(2 * noise / scale);
     for (int attempt = 0; attempt < 60; ++attempt, t0 *= 0.5)
       if (std::fabs(second) > t0 * W.norm_eA2 * std::exp(growth * t0) * z0) return t0;
@@ -133,50 +255,23 @@ std::optional<double> certified_departure(const LinearWitness& witness, double n
   return std::nullopt;
 }
 
+std::optional<double> certified_departure(const LinearWitness& witness, double noise) {
+  return certified_departure(WitnessMode(witness.A, witness.c, witness.e, witness.time_unit), witness.state(0), noise);
+}
+
+std::optional<Crossing> first_crossing(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample, double level,
+                                       double t_begin, double t_end, const CrossingOptions& options) {
+  return search(Sampler(mode, sample, level), nullptr, t_begin, t_end, options);
+}
+
 std::optional<Crossing> first_crossing(const LinearWitness& witness, double t_begin, double t_end,
                                        const CrossingOptions& options) {
   if (!(t_end > t_begin)) return std::nullopt;
-  const Witness W(witness);
-  long examined = 0;
-  // Depth-first, left half first: a stack of intervals whose top is the leftmost.
-  std::vector<std::pair<Sample, Sample>> stack;
-  stack.push_back({W.at(t_begin), W.at(t_end)});
-  while (!stack.empty()) {
-    if (++examined > options.max_intervals)
-      throw SearchBudgetExhausted("the certified event search exhausted its budget of " +
-                                  std::to_string(options.max_intervals) + " intervals");
-    auto [a, b] = stack.back();
-    stack.pop_back();
-    if (!std::isfinite(a.w) || !std::isfinite(b.w)) throw std::runtime_error("first_crossing: non-finite witness");
-    if (a.w == 0 && a.t > t_begin) return Crossing{a.t, false, examined};
-    const double h = b.t - a.t;
-    const double M3 = witness.third_derivative_bound ? witness.third_derivative_bound(a.t, b.t) : W.third_bound(a, h);
-    const double M2 = 0.5 * (std::fabs(a.w2) + std::fabs(b.w2) + h * M3);
-    const double M1 = 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) + h * M2);
-    const bool sign_change = !same_sign(a.w, b.w);
-    if (!sign_change && std::fabs(a.w) + std::fabs(b.w) > h * M1) continue;  // excluded
-    const bool monotone = same_sign(a.w1, b.w1) && 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) - h * M2) > 0;
-    if (monotone || h < options.min_interval * witness.time_unit) {
-      if (sign_change) {
-        if (b.w == 0) return Crossing{b.t, false, examined};
-        const auto f = [&](double t) { return W.at(t).w; };
-        boost::uintmax_t iterations = 200;
-        const double tolerance = options.time_tolerance, unit = witness.time_unit;
-        const auto root = boost::math::tools::toms748_solve(
-            f, a.t, b.t, a.w, b.w,
-            [tolerance, unit](double lo, double hi) { return hi - lo <= tolerance * std::max(unit, std::fabs(hi)); },
-            iterations);
-        return Crossing{0.5 * (root.first + root.second), false, examined};
-      }
-      if (monotone) continue;  // monotone without a sign change: no root
-      // Uncertified down to the resolution: the witness touches the level here.
-      return Crossing{std::fabs(a.w) <= std::fabs(b.w) ? a.t : b.t, true, examined};
-    }
-    const Sample m = W.at(a.t + 0.5 * h);
-    stack.push_back({m, b});
-    stack.push_back({a, m});
-  }
-  return std::nullopt;
+  const WitnessMode mode(witness.A, witness.c, witness.e, witness.time_unit);
+  const auto sample = [&witness](double t) { return sample_of(witness, t); };
+  const std::function<double(double, double)>* bound =
+      witness.third_derivative_bound ? &witness.third_derivative_bound : nullptr;
+  return search(Sampler(mode, sample, witness.level), bound, t_begin, t_end, options);
 }
 
 }  // namespace backlash::numeric

@@ -20,6 +20,15 @@
 //   – otherwise bisects, always examining the left half first.
 // An interval that can be neither excluded nor certified down to `min_interval`
 // is a grazing contact (w touches the level): it is reported as such.
+//
+// Cost (docs/design.md, "The event loop"): the mode's constants (eᵀA, eᵀA², μ∞, the balancing D)
+// are a WitnessMode, built once per mode and parameter set; a search samples the closed form once
+// per point (WitnessSample: the state and the witness's value together); the bisection's stack is
+// inline; and an interval too long for either test to pass — decided from its left end alone,
+// with the bounds above — is halved without sampling its right end.  The intervals examined, their
+// order and every sample taken are those of the plain search (so every crossing is bit for bit
+// the same); only the samples that could not change a decision are left out, so a search's cost
+// does not grow with t_end − t_begin beyond a few flops per halving.
 #pragma once
 
 #include <Eigen/Dense>
@@ -27,6 +36,7 @@
 #include <functional>
 #include <optional>
 #include <stdexcept>
+#include <type_traits>
 
 namespace backlash::numeric {
 
@@ -54,6 +64,46 @@ struct LinearWitness {
   /// cases): the floor of the root's relative tolerance and the unit of min_interval, so that a
   /// servo a million times faster is resolved as finely in its own time.
   double time_unit = 1;
+};
+
+/// A non-owning reference to a callable (like C++26 std::function_ref): no allocation, no copy.
+/// The callable must outlive the reference (pass lambdas straight to the call that uses them).
+template <class Signature>
+class FunctionRef;
+template <class R, class... Args>
+class FunctionRef<R(Args...)> {
+ public:
+  template <class F, class = std::enable_if_t<!std::is_same_v<std::decay_t<F>, FunctionRef>>>
+  FunctionRef(const F& f) noexcept  // NOLINT: implicit, like std::function_ref
+      : object_(&f), call_([](const void* o, Args... args) -> R { return (*static_cast<const F*>(o))(args...); }) {}
+  R operator()(Args... args) const { return call_(object_, args...); }
+
+ private:
+  const void* object_;
+  R (*call_)(const void*, Args...);
+};
+
+/// One point of a witness: the exact state x(t) and w(t) + level, from one closed-form evaluation.
+struct WitnessSample {
+  SmallVector x;
+  double value = 0;
+};
+
+/// The constants of a witness w = eᵀx − level on a mode x' = A x + c that the certified bounds use
+/// (eᵀA, eᵀA², eᵀA³, μ∞ of the balanced A, ‖eᵀA²D⁻¹‖₁ …): computed once per mode and parameter
+/// set, not per search.
+struct WitnessMode {
+  WitnessMode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e, double time_unit = 1);
+  SmallMatrix A;
+  SmallVector c;
+  SmallRow e, eA, eA2, eA3;
+  SmallVector scale;  ///< D (powers of two): the bounds are in ‖D·‖∞
+  double ec, eAc, eA2c;  ///< eᵀc, eᵀA c, eᵀA² c
+  double mu_A;           ///< μ∞(D A D⁻¹), the growth rate of ‖D x'‖∞
+  double norm_e, norm_eA2, norm_eA3;  ///< ‖eᵀD⁻¹‖₁, ‖eᵀA²D⁻¹‖₁, ‖eᵀA³D⁻¹‖₁
+  double norm_e_plain, norm_eA, norm_A;  ///< ‖eᵀ‖₁, ‖eᵀA‖₁, ‖D A‖∞ (rounding scales)
+  double inverse_scale;  ///< max 1/D_i
+  double time_unit;  ///< as LinearWitness::time_unit
 };
 
 struct Crossing {
@@ -88,5 +138,14 @@ std::optional<double> certified_departure(const LinearWitness& witness, double n
 /// First t in (t_begin, t_end] with w(t) = 0, or nothing.
 std::optional<Crossing> first_crossing(const LinearWitness& witness, double t_begin, double t_end,
                                        const CrossingOptions& options = {});
+
+/// The same search on a mode built once: `sample(t)` gives x(t) and w(t) + `level` together
+/// (one closed-form evaluation per point).  Same answers, bit for bit, as the LinearWitness form
+/// with state = x and value = w + level.
+std::optional<Crossing> first_crossing(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample, double level,
+                                       double t_begin, double t_end, const CrossingOptions& options = {});
+
+/// certified_departure on a mode built once, from the start state x(0).
+std::optional<double> certified_departure(const WitnessMode& mode, const SmallVector& x0, double noise);
 
 }  // namespace backlash::numeric
