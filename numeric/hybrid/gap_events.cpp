@@ -1,5 +1,7 @@
 #include "hybrid/gap_events.hpp"
 
+#include <algorithm>
+
 namespace backlash::numeric::detail {
 
 LinearWitness gap_change_witness(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
@@ -17,20 +19,30 @@ LinearWitness gap_change_witness(const LinearSegment& free_segment, std::functio
   return w;
 }
 
-std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
-                                        std::function<double(double)> gap_change, double opposite_face_change,
-                                        double horizon, double position_scale, double time_unit) {
-  LinearWitness w =
-      gap_change_witness(free_segment, std::move(state), std::move(gap_change), opposite_face_change, time_unit);
-  const std::optional<Crossing> opposite = first_crossing(w, 0, horizon);
+WitnessMode gap_witness_mode(const LinearSegment& free_segment, double time_unit) {
+  SmallRow e = SmallRow::Zero(4);
+  e(0) = -1;
+  e(2) = 1;
+  return WitnessMode(free_segment.A, free_segment.c, e, time_unit);
+}
+
+std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
+                                        double opposite_face_change, double horizon, double position_scale) {
+  const std::optional<Crossing> opposite = first_crossing(gap_mode, sample, opposite_face_change, 0, horizon);
   // Return to the face left: Δx starts as O(t²) or O(t³), below rounding noise at first.
-  w.level = 0;
   std::optional<Crossing> back;
-  const std::optional<double> t0 = certified_departure(w, 1e-10 * std::max(1.0, position_scale));
-  if (t0) back = first_crossing(w, *t0, opposite ? opposite->t : horizon);
+  const std::optional<double> t0 = certified_departure(gap_mode, sample(0).x, 1e-10 * std::max(1.0, position_scale));
+  if (t0) back = first_crossing(gap_mode, sample, 0, *t0, opposite ? opposite->t : horizon);
   if (back && (!opposite || back->t < opposite->t)) return GapEvent{GapEventKind::FaceLeft, *back, *t0};
   if (opposite) return GapEvent{GapEventKind::OppositeFace, *opposite};
   return std::nullopt;
+}
+
+std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
+                                        std::function<double(double)> gap_change, double opposite_face_change,
+                                        double horizon, double position_scale, double time_unit) {
+  const auto sample = [&state, &gap_change](double t) { return WitnessSample{state(t), gap_change(t)}; };
+  return first_gap_event(gap_witness_mode(free_segment, time_unit), sample, opposite_face_change, horizon, position_scale);
 }
 
 }  // namespace backlash::numeric::detail

@@ -30,4 +30,12 @@ std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::
                                         std::function<double(double)> gap_change, double opposite_face_change,
                                         double horizon, double position_scale, double time_unit = 1);
 
+/// The same on the free mode's gap witness built once (`gap_mode`: e = θL − θm on the free
+/// segment), `sample(t)` giving x(t) and Δx(t) from one closed-form evaluation.
+std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
+                                        double opposite_face_change, double horizon, double position_scale);
+
+/// The gap witness's mode: e = θL − θm on the free segment.
+WitnessMode gap_witness_mode(const LinearSegment& free_segment, double time_unit);
+
 }  // namespace backlash::numeric::detail

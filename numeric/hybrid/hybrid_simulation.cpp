@@ -10,9 +10,9 @@
 #include <boost/math/tools/roots.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <cmath>
-#include <deque>
 #include <functional>
 #include <limits>
 
@@ -102,64 +102,64 @@ bool finite(const HybridState& s) {
   return std::isfinite(s.theta_m) && std::isfinite(s.theta_L) && std::isfinite(s.dtheta_m) && std::isfinite(s.dtheta_L);
 }
 
-// A free flight in the simulation frame: state(τ) and the gap change since its start.
-struct Flight {
-  std::function<HybridState(double)> at;
-  std::function<SmallVector(double)> vector;
-  std::function<double(double)> gap_change;
+HybridState free_state_of(const SmallVector& x, int face) {
+  HybridState h;
+  h.in_contact = false;
+  h.face = face;
+  h.theta_m = x(0);
+  h.dtheta_m = x(1);
+  h.theta_L = x(2);
+  h.dtheta_L = x(3);
+  return h;
+}
+
+// A free flight in the simulation frame: state(τ) and the gap change since its start — from the
+// separation line's validated closed form (t, θ̇m0), or after a bounce from the exact exponential
+// of the segment (linear_flight.hpp).  Held by value: no allocation per flight.
+class Flight {
+ public:
+  static Flight from_separation_line(const ValidatedEvaluator& evaluator, const HybridState& start) {
+    Flight f;
+    f.evaluator_ = &evaluator;
+    f.v_ = start.dtheta_m;
+    const double theta0 = evaluator.evaluator().separation_theta(f.v_);  // thesis frame: θm(0) = θL(0) = θ0
+    f.offset_m_ = start.theta_m - theta0;
+    f.offset_L_ = start.theta_L - theta0;
+    f.face_ = start.face;
+    return f;
+  }
+  static Flight from_state(const Parameters& p, const HybridState& start) {
+    SmallVector x0(4);
+    x0 << start.theta_m, start.dtheta_m, start.theta_L, start.dtheta_L;
+    Flight f;
+    f.linear_.emplace(free_mode_segment(p), x0);
+    f.face_ = start.face;
+    return f;
+  }
+  HybridState at(double tau) const { return free_state_of(vector(tau), face_); }
+  SmallVector vector(double tau) const { return gap_sample(tau, false).x; }
+  /// x(τ) and the gap change Δx(τ): one closed-form evaluation (`with_gap` false: x alone).
+  WitnessSample gap_sample(double tau, bool with_gap = true) const {
+    if (linear_) {
+      WitnessSample s{linear_->state(tau), 0};
+      if (with_gap) {
+        const SmallVector dx = linear_->change(tau);
+        s.value = dx(2) - dx(0);
+      }
+      return s;
+    }
+    const FreeState f = evaluator_->free_state(tau, v_);
+    WitnessSample s{SmallVector(4), f.gap};
+    s.x << f.theta_m + offset_m_, f.dtheta_m, f.theta_L + offset_L_, f.dtheta_L;
+    return s;
+  }
+
+ private:
+  const ValidatedEvaluator* evaluator_ = nullptr;
+  double v_ = 0, offset_m_ = 0, offset_L_ = 0;
+  int face_ = 0;
+  std::optional<LinearFlight> linear_;
 };
-
-Flight flight_from_separation_line(const ValidatedEvaluator& evaluator, const HybridState& start) {
-  const Parameters& p = evaluator.parameters();
-  const double v = start.dtheta_m;
-  const double theta0 = evaluator.evaluator().separation_theta(v);  // thesis frame: θm(0) = θL(0) = θ0
-  const double offset_m = start.theta_m - theta0, offset_L = start.theta_L - theta0;
-  (void)p;
-  Flight f;
-  f.at = [&evaluator, v, offset_m, offset_L, face = start.face](double tau) {
-    const FreeState s = evaluator.free_state(tau, v);
-    HybridState h;
-    h.in_contact = false;
-    h.face = face;
-    h.theta_m = s.theta_m + offset_m;
-    h.theta_L = s.theta_L + offset_L;
-    h.dtheta_m = s.dtheta_m;
-    h.dtheta_L = s.dtheta_L;
-    return h;
-  };
-  f.vector = [at = f.at](double tau) {
-    const HybridState h = at(tau);
-    SmallVector x(4);
-    x << h.theta_m, h.dtheta_m, h.theta_L, h.dtheta_L;
-    return x;
-  };
-  f.gap_change = [&evaluator, v](double tau) { return evaluator.free_state(tau, v).gap; };
-  return f;
-}
-
-Flight flight_from_state(const Parameters& p, const HybridState& start) {
-  SmallVector x0(4);
-  x0 << start.theta_m, start.dtheta_m, start.theta_L, start.dtheta_L;
-  auto flight = std::make_shared<LinearFlight>(free_mode_segment(p), x0);
-  Flight f;
-  f.vector = [flight](double tau) { return flight->state(tau); };
-  f.at = [flight, face = start.face](double tau) {
-    const SmallVector x = flight->state(tau);
-    HybridState h;
-    h.in_contact = false;
-    h.face = face;
-    h.theta_m = x(0);
-    h.dtheta_m = x(1);
-    h.theta_L = x(2);
-    h.dtheta_L = x(3);
-    return h;
-  };
-  f.gap_change = [flight](double tau) {
-    const SmallVector dx = flight->change(tau);
-    return dx(2) - dx(0);
-  };
-  return f;
-}
 
 // A velocity as the angle it sweeps in the servo's time unit √(J/K) (1 s for the thesis's cases):
 // the scale of a state's angles for rounding tolerances, whatever the gain.
@@ -171,33 +171,64 @@ bool on_separation_line(const ValidatedEvaluator& evaluator, double theta_o, dou
   return std::fabs(theta_o - line) <= 1e-9 * scale;
 }
 
-// Extremes of a segment on [0, duration]: its end states and the certified zeros of θ̇m and θ̇L
-// (in contact both are θ̇o).  `vector(τ)` is the segment's state x, x' = A x + c.
-void segment_extremes(const Parameters& p, const LinearSegment& segment, const std::function<SmallVector(double)>& vector,
-                      const std::function<HybridState(double)>& at, double duration, bool contact, Extremes& x) {
+// The witness of one velocity (row of x) on a segment: its zeros are the extremes of the angle.
+WitnessMode velocity_mode(const LinearSegment& segment, Eigen::Index row, double time_unit) {
+  SmallRow e = SmallRow::Zero(segment.A.rows());
+  e(row) = 1;
+  return WitnessMode(segment.A, segment.c, e, time_unit);
+}
+
+// Extremes of a segment on [0, duration]: its end states and the certified zeros of the
+// velocities whose witnesses are `velocity_modes` (θ̇m and θ̇L; in contact both are θ̇o).
+// `vector(τ)` is the segment's state x, x' = A x + c.
+void segment_extremes(const Parameters& p, const WitnessMode* velocity_modes, int count,
+                      FunctionRef<SmallVector(double)> vector, FunctionRef<HybridState(double)> at, double duration,
+                      Extremes& x) {
   include_extremes(p, at(0), x);
   include_extremes(p, at(duration), x);
-  const Eigen::Index n = segment.A.rows();
-  std::vector<Eigen::Index> velocity_rows = contact ? std::vector<Eigen::Index>{1} : std::vector<Eigen::Index>{1, 3};
-  for (Eigen::Index row : velocity_rows) {
-    LinearWitness w;
-    w.A = segment.A;
-    w.c = segment.c;
-    w.e = SmallRow::Zero(n);
-    w.e(row) = 1;
-    w.state = vector;
-    w.time_unit = servo_time_unit(p);
+  for (int i = 0; i < count; ++i) {
+    const WitnessMode& mode = velocity_modes[i];
+    const auto sample = [&vector, &mode](double t) {
+      WitnessSample s{vector(t), 0};
+      s.value = mode.e.dot(s.x);
+      return s;
+    };
     double from = 0;
     for (int k = 0; k < 10000; ++k) {
-      const auto zero = first_crossing(w, from, duration);
+      const auto zero = first_crossing(mode, sample, 0, from, duration);
       if (!zero) break;
       include_extremes(p, at(zero->t), x);
-      from = zero->t + 1e-12 * std::max(w.time_unit, zero->t);
+      from = zero->t + 1e-12 * std::max(mode.time_unit, zero->t);
       if (from >= duration) break;
     }
   }
 }
 
+// The times of the recent impacts, for the Zeno rule: a ring that grows only when more impacts
+// than ever before fall into the window (never per event in a steady motion).
+class ImpactWindow {
+ public:
+  /// Records an impact at t, forgets those before t − window; the count in the window.
+  std::size_t add(double t, double window) {
+    if (count_ == ring_.size()) grow();
+    ring_[(head_ + count_++) % ring_.size()] = t;
+    while (count_ > 0 && ring_[head_] < t - window) {
+      head_ = (head_ + 1) % ring_.size();
+      --count_;
+    }
+    return count_;
+  }
+
+ private:
+  void grow() {
+    std::vector<double> larger(std::max<std::size_t>(16, 2 * ring_.size()));
+    for (std::size_t i = 0; i < count_; ++i) larger[i] = ring_[(head_ + i) % ring_.size()];
+    ring_.swap(larger);
+    head_ = 0;
+  }
+  std::vector<double> ring_;
+  std::size_t head_ = 0, count_ = 0;
+};
 
 }  // namespace
 
@@ -246,8 +277,19 @@ class ClosedFormRun {
         contact_segment_(contact_mode_segment(p_)),
         free_segment_(free_mode_segment(p_)),
         torque_(transmitted_torque(p_)),
+        contact_mode_(contact_segment_.A, contact_segment_.c, torque_.r, servo_time_unit(p_)),
+        gap_mode_(detail::gap_witness_mode(free_segment_, servo_time_unit(p_))),
+        cancellation_scale_(4096 * std::numeric_limits<double>::epsilon() * std::fabs(torque_.r(0)) *
+                            std::max(1.0, std::fabs(p_.theta_R))),
         rigid_(p_.backlash <= 0),  // a rigid drive: contact for ever, no events
-        state_(rigid_ ? rigid_start(p_, start) : start) {}
+        state_(rigid_ ? rigid_start(p_, start) : start) {
+    if (o_.track_extremes) {
+      const double unit = servo_time_unit(p_);
+      contact_velocity_.emplace(velocity_mode(contact_segment_, 1, unit));
+      free_velocities_.emplace(
+          std::array<WitnessMode, 2>{velocity_mode(free_segment_, 1, unit), velocity_mode(free_segment_, 3, unit)});
+    }
+  }
 
   SimulationResult run() {
     try {
@@ -293,8 +335,8 @@ class ClosedFormRun {
   }
 
   std::optional<SimulationStatus> contact();
-  LinearWitness contact_torque_witness(double theta0, double omega0) const;
-  std::optional<Crossing> separation(const LinearWitness& w, double theta0, double omega0, double remaining) const;
+  WitnessSample torque_sample(double tau, double theta0, double omega0) const;
+  std::optional<Crossing> separation(double theta0, double omega0, double remaining) const;
   std::optional<SimulationStatus> flight();
   SimulationStatus rest(const Flight& flight, double remaining, const HybridState& end);
   std::optional<SimulationStatus> impact(const detail::GapEvent& event, const HybridState& before);
@@ -307,61 +349,56 @@ class ClosedFormRun {
   TrajectoryRecorder recorder_;
   const LinearSegment contact_segment_, free_segment_;
   const TransmittedTorque torque_;
+  // The witnesses' constants, once per run (mode and parameter set): Tc in contact, the gap in flight,
+  // and (track_extremes) the velocities.
+  const WitnessMode contact_mode_, gap_mode_;
+  std::optional<WitnessMode> contact_velocity_;
+  std::optional<std::array<WitnessMode, 2>> free_velocities_;
+  const double cancellation_scale_;  // see torque_sample
   const bool rigid_;
   HybridState state_;
   double t_ = 0;
-  std::deque<double> impacts_;
+  ImpactWindow impacts_;
   long separations_ = 0;
   long events_ = 0;  // events so far (kept or sunk)
 };
 
-// Tc = JL θ̈o + FL θ̇o along the contact segment from (θ0, ω0), as a certified witness.
-LinearWitness ClosedFormRun::contact_torque_witness(double theta0, double omega0) const {
-  LinearWitness w;
-  w.A = contact_segment_.A;
-  w.c = contact_segment_.c;
-  w.e = torque_.r;
-  w.level = 0;  // w = Tc, given directly by `value` below (eᵀx' and its bounds need no level)
-  w.time_unit = servo_time_unit(p_);
-  const ValidatedEvaluator& evaluator = evaluator_;
-  w.state = [&evaluator, theta0, omega0](double tau) {
-    const ContactState c = evaluator.contact_state(tau, theta0, omega0);
-    SmallVector y(2);
-    y << c.theta_o, c.dtheta_o;
-    return y;
-  };
+// Tc = JL θ̈o + FL θ̇o along the contact segment from (θ0, ω0), with the state y = (θo, θ̇o) at τ
+// from the same closed-form evaluation: one sample of the certified witness.
+WitnessSample ClosedFormRun::torque_sample(double tau, double theta0, double omega0) const {
+  const ContactState c = evaluator_.contact_state(tau, theta0, omega0);
+  WitnessSample s{SmallVector(2), 0};
+  s.x << c.theta_o, c.dtheta_o;
   // Tc = (JL K/J)(θR − θo) + (FL − JL F/J) θ̇o without the cancellation θR − θo: by
   // linearity θo − θR = (θo0 − θR)·a(τ) + θ̇o0·b(τ) with the unit responses a, b of the
   // validated closed form, so the rounding error scales with the motion, not with θR.
   // Far from a zero of Tc the cancellation is harmless, so the unit responses are only
-  // evaluated where |Tc| is within a few thousand ulps of θR's scale.
-  const double cancellation_scale = 4096 * std::numeric_limits<double>::epsilon() * std::fabs(torque_.r(0)) *
-                                    std::max(1.0, std::fabs(p_.theta_R));
-  w.value = [&evaluator, &p = p_, &torque = torque_, theta0, omega0, cancellation_scale](double tau) {
-    const ContactState c = evaluator.contact_state(tau, theta0, omega0);
-    const double direct = torque.r(0) * (c.theta_o - p.theta_R) + torque.r(1) * c.dtheta_o;
-    if (std::fabs(direct) > cancellation_scale) return direct;
-    const double a = evaluator.contact_state(tau, p.theta_R + 1, 0).theta_o - p.theta_R;
-    const double b = evaluator.contact_state(tau, p.theta_R, 1).theta_o - p.theta_R;
-    const double deviation = (theta0 - p.theta_R) * a + omega0 * b;
-    return torque.r(0) * deviation + torque.r(1) * c.dtheta_o;
-  };
-  return w;
+  // evaluated where |Tc| is within a few thousand ulps of θR's scale (cancellation_scale_).
+  const double direct = torque_.r(0) * (c.theta_o - p_.theta_R) + torque_.r(1) * c.dtheta_o;
+  if (std::fabs(direct) > cancellation_scale_) {
+    s.value = direct;
+    return s;
+  }
+  const double a = evaluator_.contact_state(tau, p_.theta_R + 1, 0).theta_o - p_.theta_R;
+  const double b = evaluator_.contact_state(tau, p_.theta_R, 1).theta_o - p_.theta_R;
+  const double deviation = (theta0 - p_.theta_R) * a + omega0 * b;
+  s.value = torque_.r(0) * deviation + torque_.r(1) * c.dtheta_o;
+  return s;
 }
 
 // The next time Tc leaves its holding sign within `remaining` (a grazing touch keeps contact).
-std::optional<Crossing> ClosedFormRun::separation(const LinearWitness& w, double theta0, double omega0,
-                                                  double remaining) const {
+std::optional<Crossing> ClosedFormRun::separation(double theta0, double omega0, double remaining) const {
+  const auto sample = [this, theta0, omega0](double tau) { return torque_sample(tau, theta0, omega0); };
   std::optional<Crossing> separation;
   double from = 0;
   if (std::fabs(transmitted_torque_at(p_, theta0, omega0)) <= 1e-13 * std::max(1.0, std::fabs(omega0))) {
     // Starting on the separation line: certified departure of Tc first.
-    if (auto t0 = certified_departure(w, 1e-12)) from = *t0;
+    if (auto t0 = certified_departure(contact_mode_, sample(0).x, 1e-12)) from = *t0;
   }
   while (!rigid_) {
-    separation = first_crossing(w, from, remaining);
+    separation = first_crossing(contact_mode_, sample, 0, from, remaining);
     if (!separation || !separation->grazing) break;
-    from = separation->t + 1e-12 * std::max(w.time_unit, separation->t);
+    from = separation->t + 1e-12 * std::max(contact_mode_.time_unit, separation->t);
   }
   // Tc = r·y + r0 goes through the cancellation θR − θo: once the contact motion has decayed
   // to rounding level its sign is noise, and a "separation" found there is spurious (e.g. an
@@ -381,15 +418,16 @@ std::optional<Crossing> ClosedFormRun::separation(const LinearWitness& w, double
 std::optional<SimulationStatus> ClosedFormRun::contact() {
   const double remaining = o_.t_end - t_;
   const double theta0 = measured(p_, state_), omega0 = state_.dtheta_m;
-  const LinearWitness w = contact_torque_witness(theta0, omega0);
   const int face = state_.face;
   auto at = [&evaluator = evaluator_, &p = p_, theta0, omega0, face](double tau) {
     const ContactState c = evaluator.contact_state(tau, theta0, omega0);
     return contact_state_on_face(p, face, c.theta_o, c.dtheta_o);
   };
-  const std::optional<Crossing> separated = separation(w, theta0, omega0, remaining);
-  if (o_.track_extremes)
-    segment_extremes(p_, contact_segment_, w.state, at, separated ? separated->t : remaining, true, result_.extremes);
+  const std::optional<Crossing> separated = separation(theta0, omega0, remaining);
+  if (o_.track_extremes) {
+    const auto vector = [this, theta0, omega0](double tau) { return torque_sample(tau, theta0, omega0).x; };
+    segment_extremes(p_, &*contact_velocity_, 1, vector, at, separated ? separated->t : remaining, result_.extremes);
+  }
   if (!separated) {
     recorder_.record(t_, o_.t_end + 1e-12, at);
     state_ = at(remaining);
@@ -412,16 +450,17 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   const double theta_o = measured(p_, state_);
   const bool from_line = std::fabs(state_.dtheta_m - state_.dtheta_L) <= 1e-12 * std::max(1.0, std::fabs(state_.dtheta_m)) &&
                          on_separation_line(evaluator_, theta_o, state_.dtheta_m);
-  const Flight flight = from_line ? flight_from_separation_line(evaluator_, state_) : flight_from_state(p_, state_);
+  const Flight flight = from_line ? Flight::from_separation_line(evaluator_, state_) : Flight::from_state(p_, state_);
+  const auto at = [&flight](double tau) { return flight.at(tau); };
   const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(p_, state_.dtheta_m))});
-  const auto event =
-      detail::first_gap_event(free_segment_, flight.vector, flight.gap_change, -state_.face * p_.backlash, remaining, scale,
-                              servo_time_unit(p_));
-  if (o_.track_extremes)
-    segment_extremes(p_, free_segment_, flight.vector, flight.at, event ? event->crossing.t : remaining, false,
-                     result_.extremes);
+  const auto sample = [&flight](double tau) { return flight.gap_sample(tau); };
+  const auto event = detail::first_gap_event(gap_mode_, sample, -state_.face * p_.backlash, remaining, scale);
+  if (o_.track_extremes) {
+    const auto vector = [&flight](double tau) { return flight.vector(tau); };
+    segment_extremes(p_, free_velocities_->data(), 2, vector, at, event ? event->crossing.t : remaining, result_.extremes);
+  }
   if (!event) {
-    recorder_.record(t_, o_.t_end + 1e-12, flight.at);
+    recorder_.record(t_, o_.t_end + 1e-12, at);
     const HybridState end = flight.at(remaining);
     const double speed = std::max(std::fabs(end.dtheta_m), std::fabs(end.dtheta_L));
     if (speed < o_.rest_velocity) return rest(flight, remaining, end);
@@ -433,7 +472,7 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
     result_.stop_reason = std::move(*problem);
     return SimulationStatus::Unresolved;
   }
-  recorder_.record(t_, t_ + event->crossing.t + 1e-12, flight.at);
+  recorder_.record(t_, t_ + event->crossing.t + 1e-12, at);
   const HybridState before = flight.at(event->crossing.t);
   t_ += event->crossing.t;
   return impact(*event, before);
@@ -480,10 +519,8 @@ std::optional<SimulationStatus> ClosedFormRun::impact(const detail::GapEvent& ev
   const bool holds = -face_hit * tc >= -1e-14 * std::max(1.0, std::fabs(tc));
   if (!holds) state_.in_contact = false;  // a bounce: the bodies part again at once
   push_event(opposite ? EventKind::Recombination : EventKind::Recontact, !holds, event.crossing.grazing);
-  impacts_.push_back(t_);
   const double window = zeno_window(p_, o_);
-  while (!impacts_.empty() && impacts_.front() < t_ - window) impacts_.pop_front();
-  if (static_cast<int>(impacts_.size()) >= o_.zeno_impacts) {
+  if (static_cast<long long>(impacts_.add(t_, window)) >= o_.zeno_impacts) {
     result_.stop_reason = zeno_reason(o_, window);
     return SimulationStatus::Chattering;
   }
