@@ -5,7 +5,10 @@
 #include <boost/container/small_vector.hpp>
 #include <boost/math/tools/roots.hpp>
 
+#include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -71,10 +74,19 @@ class Sampler {
   }
   double value(double t) const { return sample_(t).value - level_; }
 
+  // e^{μ⁺h}.  The intervals of a search have few distinct lengths (t_end − t_begin halved k
+  // times), so the last values are kept: the same h gives the same bits, one exp per length.
+  double growth(double h) const {
+    const std::uint64_t bits = std::bit_cast<std::uint64_t>(h);
+    GrowthEntry& entry = growth_cache_[(bits ^ (bits >> 29)) % growth_cache_.size()];
+    if (!(entry.h == h)) entry = {h, std::exp(std::max(0.0, m_.mu_A) * h)};
+    return entry.E;
+  }
+
   // sup |w'''| on [a.t, a.t + h]: w''' = eA² z = (eA² D⁻¹)(D z) and ‖D z(t)‖∞ ≤
   // e^{μ∞(DAD⁻¹)(t−a)} ‖D z(a)‖∞ (the supremum of e^{μ s} over s ∈ [0, h] is 1 when μ ≤ 0).
   double third_bound(const Sample& a, double h) const {
-    return m_.norm_eA2 * std::exp(std::max(0.0, m_.mu_A) * h) * a.rate_norm;
+    return m_.norm_eA2 * growth(h) * a.rate_norm;
   }
 
   // Whether [a.t, a.t + h] is certain to be halved by the search below — neither excluded nor
@@ -88,7 +100,7 @@ class Sampler {
   // Where e^{μh} overflows the search's own bounds are infinite (or NaN) and it halves too.
   bool must_halve(const Sample& a, double h, double min_length) const {
     if (!(h >= min_length)) return false;
-    const double E = std::exp(std::max(0.0, m_.mu_A) * h);
+    const double E = growth(h);
     const double M3 = m_.norm_eA2 * E * a.rate_norm;
     if (!(M3 < INFINITY)) return true;  // the search's M2 and M1 are then infinite or NaN: no test passes
     const double rate_bound = a.rate_norm + kSampleNoise * m_.norm_A * a.x_norm;  // rounding of z = A x + c
@@ -103,9 +115,13 @@ class Sampler {
   }
 
  private:
+  struct GrowthEntry {
+    double h = NAN, E = 0;
+  };
   const WitnessMode& m_;
   FunctionRef<WitnessSample(double)> sample_;
   double level_;
+  mutable std::array<GrowthEntry, 16> growth_cache_{};
 };
 
 bool same_sign(double x, double y) { return (x > 0 && y > 0) || (x < 0 && y < 0); }
