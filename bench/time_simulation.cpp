@@ -5,7 +5,12 @@
 //                                        (simulate_step_with_odeint) at the tolerance that
 //                                        gives event times within 1e-10 of the closed form;
 //   time_DividingLine1000/<case>         trace_dividing_lines with 1000 θ̇m0 values
-//                                        (target ≤ 1 ms).
+//                                        (target ≤ 1 ms);
+//   time_ClosedFormPerEvent/<case>/<T>   the same step response to T = 60 s and 60,000 s with
+//                                        the events sunk (event_sink, nothing kept): the cost
+//                                        per event and whether it grows with the horizon.
+// Every closed-form benchmark counts the heap allocations of its timed loop (the global
+// operator new below): counters allocs_per_run and, per event, allocs_per_event.
 // Each case's step is its [experiment] step (the thesis's first worked step input).
 // Validation (the gate) happens once, outside the timed loops.
 //
@@ -21,12 +26,30 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cstdio>
+#include <new>
 #include <cstdlib>
 #include <cstring>
 #include <map>
 #include <string>
 #include <vector>
+
+namespace {
+std::atomic<long> allocations{0};  // every operator new of this binary (the library's too)
+}  // namespace
+
+void* operator new(std::size_t size) {
+  allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return operator new(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 namespace {
 
@@ -81,12 +104,35 @@ void time_ClosedFormStepResponse(benchmark::State& state, std::size_t index) {
   const Case& c = cases()[index];
   const auto options = simulation_options();
   std::size_t events = 0;
+  const long allocations0 = allocations.load();
   for (auto _ : state) {
     const numeric::SimulationResult r = numeric::simulate_step(*c.evaluator, c.step, options);
     events = r.events.size();
     benchmark::DoNotOptimize(r.theta_o_final);
   }
+  const double per_run = static_cast<double>(allocations.load() - allocations0) / static_cast<double>(state.iterations());
   state.counters["events"] = static_cast<double>(events);
+  state.counters["allocs_per_run"] = per_run;  // the kept event list's growth included
+}
+
+// The step response to `end` with the events sunk: the event loop alone.
+void time_ClosedFormPerEvent(benchmark::State& state, std::size_t index, double end) {
+  const Case& c = cases()[index];
+  auto options = simulation_options(end);
+  long events = 0;
+  options.event_sink = [&events](const numeric::SimulationEvent&) { ++events; };
+  long run_events = 0;
+  const long allocations0 = allocations.load();
+  for (auto _ : state) {
+    events = 0;
+    const numeric::SimulationResult r = numeric::simulate_step(*c.evaluator, c.step, options);
+    run_events = events;
+    benchmark::DoNotOptimize(r.theta_o_final);
+  }
+  const double per_run = static_cast<double>(allocations.load() - allocations0) / static_cast<double>(state.iterations());
+  state.counters["events"] = static_cast<double>(run_events);
+  state.counters["allocs_per_run"] = per_run;
+  state.counters["allocs_per_event"] = per_run / static_cast<double>(std::max(1L, run_events));
 }
 
 void time_OdeintStepResponse(benchmark::State& state, std::size_t index) {
@@ -158,6 +204,10 @@ int main(int argc, char** argv) {
         ->Unit(benchmark::kMicrosecond);
     benchmark::RegisterBenchmark(("time_DividingLine1000/" + list[i].id).c_str(), time_DividingLine1000, i)
         ->Unit(benchmark::kMicrosecond);
+    for (const double end : {60.0, 60000.0})
+      benchmark::RegisterBenchmark(("time_ClosedFormPerEvent/" + list[i].id + "/" + std::to_string(static_cast<int>(end))).c_str(),
+                                   time_ClosedFormPerEvent, i, end)
+          ->Unit(benchmark::kMicrosecond);
   }
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

@@ -67,11 +67,34 @@ class Sampler {
   Sample at(double t) const {
     const WitnessSample s = sample_(t);
     const double w = s.value - level_;
+    if (s.x.size() == 4) return fixed_size<4>(t, w, s.x.data());
+    if (s.x.size() == 2) return fixed_size<2>(t, w, s.x.data());
     const double w1 = m_.eA.dot(s.x) + m_.ec;
     const double w2 = m_.eA2.dot(s.x) + m_.eAc;
     const SmallVector z = m_.A * s.x + m_.c;  // x' obeys z' = A z
     return {t, w, w1, w2, rate_norm(z), s.x.cwiseAbs().maxCoeff()};
   }
+  // at() for the modes' sizes, unrolled, with Eigen's own order of operations for these
+  // expressions (bit for bit the same: a dot product of 4 sums the products pairwise,
+  // (a0b0 + a2b2) + (a1b1 + a3b3); A x sums each row's products left to right, then adds c).
+  template <int N>
+  Sample fixed_size(double t, double w, const double* x) const {
+    const auto dot = [x](const SmallRow& r) {
+      if constexpr (N == 4) return (r(0) * x[0] + r(2) * x[2]) + (r(1) * x[1] + r(3) * x[3]);
+      else return r(0) * x[0] + r(1) * x[1];
+    };
+    double rate = 0, size = 0;
+    for (int i = 0; i < N; ++i) {
+      double z = m_.A(i, 0) * x[0];
+      for (int j = 1; j < N; ++j) z += m_.A(i, j) * x[j];
+      z += m_.c(i);
+      const double scaled = std::fabs(z * m_.scale(i));
+      rate = i == 0 ? scaled : std::max(rate, scaled);
+      size = std::max(size, std::fabs(x[i]));
+    }
+    return {t, w, dot(m_.eA) + m_.ec, dot(m_.eA2) + m_.eAc, rate, size};
+  }
+
   double value(double t) const { return sample_(t).value - level_; }
 
   // e^{μ⁺h}.  The intervals of a search have few distinct lengths (t_end − t_begin halved k
@@ -142,10 +165,11 @@ bool quadratic_resolved(double second, double third, double time_unit) {
   return std::fabs(second) > std::fabs(third) * kStartTimeUncertainty * time_unit;
 }
 
-// An interval of the search; a lazy end (known = false) has only its time, sampled when needed.
-struct Interval {
-  Sample a, b;
-  bool a_known, b_known;
+// A right end of the search's intervals; a lazy one (known = false) has only its time, and is
+// sampled when a test needs it.
+struct End {
+  Sample s;
+  bool known;
 };
 
 Sample lazy(double t) { return {t, 0, 0, 0, 0, 0}; }
@@ -162,53 +186,57 @@ double root_in(const Sampler& W, const Sample& a, const Sample& b, const Crossin
   return 0.5 * (root.first + root.second);
 }
 
-// Depth-first, left half first: a stack of intervals whose top is the leftmost (inline storage:
-// no allocation unless the bisection goes deeper than 96 levels).
+// Depth-first, left half first.  The intervals still to examine tile [a, t_end] from the left,
+// so they are kept as their right ends (a stack whose top is the nearest) and the current left
+// end a: an interval decided hands its right end on as the next left end; a halved one pushes
+// its midpoint.  Inline storage: no allocation unless the bisection goes deeper than 96 levels.
 std::optional<Crossing> search(const Sampler& W, const std::function<double(double, double)>* third_derivative_bound,
                                double t_begin, double t_end, const CrossingOptions& options) {
   if (!(t_end > t_begin)) return std::nullopt;
   const double min_length = options.min_interval * W.mode().time_unit;
   long examined = 0;
-  boost::container::small_vector<Interval, 96> stack;
-  stack.push_back({W.at(t_begin), lazy(t_end), true, false});
-  while (!stack.empty()) {
+  boost::container::small_vector<End, 96> ends;
+  Sample a = W.at(t_begin);
+  ends.push_back({lazy(t_end), false});
+  while (!ends.empty()) {
     if (++examined > options.max_intervals)
       throw SearchBudgetExhausted("the certified event search exhausted its budget of " +
                                   std::to_string(options.max_intervals) + " intervals");
-    Interval i = stack.back();
-    stack.pop_back();
-    Sample& a = i.a;
-    Sample& b = i.b;
-    if (!i.a_known) a = W.at(a.t);
+    End& end = ends.back();
+    Sample& b = end.s;
     const double h = b.t - a.t;
     const bool halve = !third_derivative_bound && std::isfinite(a.w) && W.must_halve(a, h, min_length);
-    if (!halve && !i.b_known) b = W.at(b.t);
+    if (!halve && !end.known) {
+      b = W.at(b.t);
+      end.known = true;
+    }
     if (!std::isfinite(a.w) || (!halve && !std::isfinite(b.w))) throw std::runtime_error("first_crossing: non-finite witness");
     if (a.w == 0 && a.t > t_begin) return Crossing{a.t, false, examined};
     if (halve) {
-      const double m = a.t + 0.5 * h;
-      stack.push_back({lazy(m), b, false, i.b_known});
-      stack.push_back({a, lazy(m), true, false});
+      ends.push_back({lazy(a.t + 0.5 * h), false});
       continue;
     }
     const double M3 = third_derivative_bound ? (*third_derivative_bound)(a.t, b.t) : W.third_bound(a, h);
     const double M2 = 0.5 * (std::fabs(a.w2) + std::fabs(b.w2) + h * M3);
     const double M1 = 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) + h * M2);
     const bool sign_change = !same_sign(a.w, b.w);
-    if (!sign_change && std::fabs(a.w) + std::fabs(b.w) > h * M1) continue;  // excluded
-    const bool monotone = same_sign(a.w1, b.w1) && 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) - h * M2) > 0;
-    if (monotone || h < min_length) {
+    const bool excluded = !sign_change && std::fabs(a.w) + std::fabs(b.w) > h * M1;
+    const bool monotone = !excluded && same_sign(a.w1, b.w1) && 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) - h * M2) > 0;
+    if (!excluded && (monotone || h < min_length)) {
       if (sign_change) {
         if (b.w == 0) return Crossing{b.t, false, examined};
         return Crossing{root_in(W, a, b, options), false, examined};
       }
-      if (monotone) continue;  // monotone without a sign change: no root
       // Uncertified down to the resolution: the witness touches the level here.
-      return Crossing{std::fabs(a.w) <= std::fabs(b.w) ? a.t : b.t, true, examined};
+      if (!monotone) return Crossing{std::fabs(a.w) <= std::fabs(b.w) ? a.t : b.t, true, examined};
+    }
+    if (excluded || monotone) {  // no root in [a, b] (monotone without a sign change): on to the next interval
+      a = b;
+      ends.pop_back();
+      continue;
     }
     const Sample m = W.at(a.t + 0.5 * h);
-    stack.push_back({m, b, true, true});
-    stack.push_back({a, m, true, true});
+    ends.push_back({m, true});
   }
   return std::nullopt;
 }
