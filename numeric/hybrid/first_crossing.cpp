@@ -190,13 +190,17 @@ double root_in(const Sampler& W, const Sample& a, const Sample& b, const Crossin
 // so they are kept as their right ends (a stack whose top is the nearest) and the current left
 // end a: an interval decided hands its right end on as the next left end; a halved one pushes
 // its midpoint.  Inline storage: no allocation unless the bisection goes deeper than 96 levels.
+// Intervals that end by `clear_until` (certified_clearance) hold no zero: they are passed over
+// unsampled, as the whole subtree the search would have spent excluding them.
 std::optional<Crossing> search(const Sampler& W, const std::function<double(double, double)>* third_derivative_bound,
-                               double t_begin, double t_end, const CrossingOptions& options) {
+                               double t_begin, double t_end, const CrossingOptions& options,
+                               double clear_until = -INFINITY) {
   if (!(t_end > t_begin)) return std::nullopt;
   const double min_length = options.min_interval * W.mode().time_unit;
   long examined = 0;
   boost::container::small_vector<End, 96> ends;
-  Sample a = W.at(t_begin);
+  Sample a = lazy(t_begin);
+  bool a_known = false;
   ends.push_back({lazy(t_end), false});
   while (!ends.empty()) {
     if (++examined > options.max_intervals)
@@ -204,6 +208,16 @@ std::optional<Crossing> search(const Sampler& W, const std::function<double(doub
                                   std::to_string(options.max_intervals) + " intervals");
     End& end = ends.back();
     Sample& b = end.s;
+    if (b.t <= clear_until) {
+      a = b;
+      a_known = end.known;
+      ends.pop_back();
+      continue;
+    }
+    if (!a_known) {
+      a = W.at(a.t);
+      a_known = true;
+    }
     const double h = b.t - a.t;
     const bool halve = !third_derivative_bound && std::isfinite(a.w) && W.must_halve(a, h, min_length);
     if (!halve && !end.known) {
@@ -232,6 +246,7 @@ std::optional<Crossing> search(const Sampler& W, const std::function<double(doub
     }
     if (excluded || monotone) {  // no root in [a, b] (monotone without a sign change): on to the next interval
       a = b;
+      a_known = true;
       ends.pop_back();
       continue;
     }
@@ -299,6 +314,37 @@ std::optional<double> certified_departure(const WitnessMode& W, const SmallVecto
   return std::nullopt;
 }
 
+// The last t ≤ first_guess (halving it) with t·bound·e^{μ⁺t}·z0 ≤ limit, or 0 when it falls below t0.
+double last_within(double first_guess, double t0, double bound, double growth, double z0, double limit) {
+  double t1 = first_guess;
+  for (int attempt = 0; attempt < 60 && t1 > t0; ++attempt, t1 *= 0.5)
+    if (t1 * bound * std::exp(growth * t1) * z0 <= limit) return t1;
+  return 0;
+}
+
+double certified_clearance(const WitnessMode& W, const SmallVector& x0, double t0, double noise) {
+  const SmallVector z = W.A * x0 + W.c;
+  const double z0 = z.cwiseProduct(W.scale).cwiseAbs().maxCoeff();
+  const double second = std::fabs(W.eA.dot(z)), third = std::fabs(W.eA2.dot(z));
+  // The computed w''(0) is within `rounding` of the exact one (a million times its ulps).
+  const double rounding = kSampleNoise * W.norm_eA *
+                          (W.A.cwiseAbs().rowwise().sum().maxCoeff() * x0.cwiseAbs().maxCoeff() + W.c.cwiseAbs().maxCoeff());
+  const double growth = std::max(0.0, W.mu_A);
+  if (second > 1e-12 * std::max(1.0, z0) && quadratic_resolved(second, third, W.time_unit)) {
+    // w'' leads (certified_departure's first case): |w(t) − w''(0)t²/2| ≤ sup|w'''| t³/6, so
+    // |w(t)| ≥ |w''(0)| t²/4 while t·sup|w'''| ≤ 1.5|w''(0)|, sup|w'''| ≤ ‖eA²D⁻¹‖₁ e^{μ⁺t} z0.
+    if (!(second > rounding) || !(second * t0 * t0 / 4 >= noise / 8)) return 0;
+    return last_within(1.5 * second / (W.norm_eA2 * z0), t0, W.norm_eA2, growth, z0, 1.5 * second);
+  }
+  // w''' leads (the separation line, w''(0) = 0 up to rounding): |w(t) − w'''(0)t³/6| ≤
+  // |w''(0)| t²/2 + sup|w''''| t⁴/24, so |w(t)| ≥ |w'''(0)| t³/12 on [t0, t] when
+  // (|w''(0)| + rounding)/(2 t0) ≤ |w'''(0)|/24 and t·sup|w''''| ≤ |w'''(0)|, sup|w''''| ≤ ‖eA³D⁻¹‖₁ e^{μ⁺t} z0.
+  if (!std::isfinite(third) || !(third > 0) || !((second + rounding) / (2 * t0) <= third / 24) ||
+      !(third * t0 * t0 * t0 / 12 >= noise / 8))
+    return 0;
+  return last_within(third / (W.norm_eA3 * z0), t0, W.norm_eA3, growth, z0, third);
+}
+
 std::optional<double> certified_departure(const LinearWitness& witness, double noise) {
   return certified_departure(WitnessMode(witness.A, witness.c, witness.e, witness.time_unit), witness.state(0), noise);
 }
@@ -306,6 +352,12 @@ std::optional<double> certified_departure(const LinearWitness& witness, double n
 std::optional<Crossing> first_crossing(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample, double level,
                                        double t_begin, double t_end, const CrossingOptions& options) {
   return search(Sampler(mode, sample, level), nullptr, t_begin, t_end, options);
+}
+
+std::optional<Crossing> first_crossing_after_departure(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample,
+                                                       double t0, double clear_until, double t_end,
+                                                       const CrossingOptions& options) {
+  return search(Sampler(mode, sample, 0), nullptr, t0, t_end, options, clear_until);
 }
 
 std::optional<Crossing> first_crossing(const LinearWitness& witness, double t_begin, double t_end,

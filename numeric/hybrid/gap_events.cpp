@@ -31,8 +31,12 @@ std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef
   const std::optional<Crossing> opposite = first_crossing(gap_mode, sample, opposite_face_change, 0, horizon);
   // Return to the face left: Δx starts as O(t²) or O(t³), below rounding noise at first.
   std::optional<Crossing> back;
-  const std::optional<double> t0 = certified_departure(gap_mode, sample(0).x, 1e-10 * std::max(1.0, position_scale));
-  if (t0) back = first_crossing(gap_mode, sample, 0, *t0, opposite ? opposite->t : horizon);
+  const double noise = 1e-10 * std::max(1.0, position_scale);
+  const SmallVector x0 = sample(0).x;
+  const std::optional<double> t0 = certified_departure(gap_mode, x0, noise);
+  if (t0)
+    back = first_crossing_after_departure(gap_mode, sample, *t0, certified_clearance(gap_mode, x0, *t0, noise),
+                                          opposite ? opposite->t : horizon);
   if (back && (!opposite || back->t < opposite->t)) return GapEvent{GapEventKind::FaceLeft, *back, *t0};
   if (opposite) return GapEvent{GapEventKind::OppositeFace, *opposite};
   return std::nullopt;

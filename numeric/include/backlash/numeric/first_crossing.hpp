@@ -148,4 +148,19 @@ std::optional<Crossing> first_crossing(const WitnessMode& mode, FunctionRef<Witn
 /// certified_departure on a mode built once, from the start state x(0).
 std::optional<double> certified_departure(const WitnessMode& mode, const SmallVector& x0, double noise);
 
+/// With w(0) = w'(0) = 0 (certified_departure's t0 from the same `noise`): a time t1 ≥ t0 up to
+/// which w keeps clear of zero by its leading term — |w(t)| ≥ |w''(0)| t²/4 when w''(0) leads
+/// (t1·sup|w'''| ≤ 1.5 |w''(0)|), |w(t)| ≥ |w'''(0)| t³/12 on the separation line (t1·sup|w''''| ≤
+/// |w'''(0)|, w''(0) within rounding of 0) — so w has no zero on [t0, t1], by at least noise/8 over
+/// the closed forms' rounding; 0 when neither term is resolved.
+double certified_clearance(const WitnessMode& mode, const SmallVector& x0, double t0, double noise);
+
+/// The search from a certified departure t0 with w ≠ 0 known on [t0, clear_until]
+/// (certified_clearance): the same answer as first_crossing(mode, sample, 0, t0, t_end) —
+/// the same intervals beyond clear_until, and the same crossing bit for bit — without sampling
+/// the intervals that end by clear_until (the subtree the plain search spends excluding them).
+std::optional<Crossing> first_crossing_after_departure(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample,
+                                                       double t0, double clear_until, double t_end,
+                                                       const CrossingOptions& options = {});
+
 }  // namespace backlash::numeric
