@@ -106,6 +106,9 @@ class Engine {
   virtual std::unique_ptr<Segment> next_segment(const Mode& mode, double remaining) = 0;
   /// Called after every event and segment (the delayed model records its history).
   virtual void advanced(double /*t_from*/, const Segment* /*segment*/) {}
+  /// How far a slipping body's friction at velocity v lies below the level e_ gives it (Stribeck
+  /// friction, effects_stribeck.cpp, where e_ carries the static level); 0 for Coulomb friction.
+  virtual double friction_drop(bool /*motor*/, double /*velocity*/) const { return 0; }
 
   Mode mode_of(const HybridState& s) const;
   double motor_static_torque(const HybridState& s) const;
@@ -142,6 +145,10 @@ class Engine {
   bool stop_reached_ = false;  ///< the event of engine_.stop_at_kind / stop_at_face happened
   std::deque<double> impacts_;
 };
+
+/// Stribeck friction (dopri5 with exact event semantics): effects_stribeck.cpp.
+SimulationResult simulate_stribeck(const Parameters& p, const Effects& e, const HybridState& start,
+                                   const SimulationOptions& options, const EffectsEngineOptions& engine);
 
 /// The delayed model (Boost.Odeint, method of steps): effects_delay.cpp.
 SimulationResult simulate_delayed(const Parameters& p, const Effects& e, const HybridState& start,

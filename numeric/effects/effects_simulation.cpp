@@ -246,6 +246,7 @@ SimulationResult simulate_effects(const ValidatedEffectModel& model, const Hybri
                                   const SimulationOptions& options, const EffectsEngineOptions& engine) {
   const Effects& e = model.effects();
   if (!e.any() && !engine.general_engine) return simulate(model.nominal(), start, options);
+  if (e.stribeck()) return detail::simulate_stribeck(model.parameters(), e, start, options, engine);
   if (e.delayed()) return detail::simulate_delayed(model.parameters(), e, start, options, engine);
   return ClosedFormEngine(model.parameters(), e, options, engine).run(start);
 }
