@@ -11,10 +11,10 @@
 //     step, steps ≤ 0.1/(fastest rate)); the transmitted torque Tc of rigid contact gets the
 //     drop as well (Engine::friction_drop);
 //   – events: the engine's witnesses (mode_witnesses), sampled at six points inside each
-//     accepted step and refined with Boost.Math's toms748, every value — samples, refinement
-//     and the states the engine reads — from one dopri5 step of the exact length from the
-//     accepted step's start (no interpolant: the state at an event carries the integrator's
-//     own error, one step's, not an interpolation's);
+//     accepted step on its cubic Hermite interpolant; a sign change found there is confirmed
+//     and refined with Boost.Math's toms748 on exact values — one dopri5 step of the exact
+//     length from the accepted step's start, as every state the engine reads (so the state
+//     at an event carries the integrator's own error, one step's, not an interpolation's);
 //   – a run tries at most kMaxSteps steps, then work_limit (exit 3).
 // The odeint simulator (odeint_effects_simulation.cpp) is an independent implementation.
 #include "effects/effects_engine.hpp"
@@ -97,7 +97,7 @@ class StribeckSegment final : public Segment {
       for (int row : rows) {
         double a = step.t0, va = step.x0[row];
         for (int k = 1; k <= kSamplesPerStep; ++k) {
-          const double b = step.t0 + (end - step.t0) * k / kSamplesPerStep, vb = advance(step, b)[row];
+          const double b = step.t0 + (end - step.t0) * k / kSamplesPerStep, vb = hermite(step, b)[row];
           if ((va > 0 && vb <= 0) || (va < 0 && vb >= 0)) {
             const double sign = va > 0 ? 1 : -1;
             include_extremes(p_, state(root_in([&](double t) { return sign * advance(step, t)[row]; }, a, b)), x);
@@ -112,7 +112,7 @@ class StribeckSegment final : public Segment {
  private:
   struct Step {
     double t0, t1;
-    State x0, x1;
+    State x0, x1, f0, f1;  // the states at the ends and their derivatives
   };
   enum class Arming { Armed, ExitNow, Departing, Waiting };
 
@@ -165,6 +165,17 @@ class StribeckSegment final : public Segment {
       odeint::runge_kutta_dopri5<State> single;
       single.do_step([this](const State& y, State& dy, double) { rhs(y, dy); }, x, step.t0, t - step.t0);
     }
+    return x;
+  }
+
+  // The step's cubic Hermite interpolant (O(h⁴)): where the samples look for sign changes; every
+  // crossing found is then refined on advance().
+  State hermite(const Step& step, double t) const {
+    const double h = step.t1 - step.t0, u = h > 0 ? (t - step.t0) / h : 0;
+    const double h00 = (1 + 2 * u) * (1 - u) * (1 - u), h10 = u * (1 - u) * (1 - u), h01 = u * u * (3 - 2 * u),
+                 h11 = u * u * (u - 1);
+    State x;
+    for (int i = 0; i < 4; ++i) x[i] = h00 * step.x0[i] + h10 * h * step.f0[i] + h01 * step.x1[i] + h11 * h * step.f1[i];
     return x;
   }
 
@@ -267,7 +278,10 @@ class StribeckSegment final : public Segment {
       }
       dt = trial;  // the stepper proposes the next step in `trial`
       if (horizon - tau < 1e-12 * std::max(1.0, horizon)) tau = horizon;
-      steps_.push_back(Step{ta, tau, xa, x});
+      Step step{ta, tau, xa, x, {}, {}};
+      rhs(xa, step.f0);
+      rhs(x, step.f1);
+      steps_.push_back(step);
       if (scan(arming, tolerances)) return;
     }
   }
@@ -280,11 +294,11 @@ class StribeckSegment final : public Segment {
     double a = step.t0;
     for (int k = 1; k <= kSamplesPerStep; ++k) {
       const double b = k == kSamplesPerStep ? step.t1 : step.t0 + (step.t1 - step.t0) * k / kSamplesPerStep;
-      const State xb = advance(step, b);
+      const State xb = hermite(step, b);
       for (std::size_t i = 0; i < witnesses_.size(); ++i) {
         const Witness& w = witnesses_[i];
         const double wb = value(w, xb);
-        if (arming[i] == Arming::Armed && wa[i] >= 0 && wb < 0) {
+        if (arming[i] == Arming::Armed && wa[i] >= 0 && wb < 0 && value(w, advance(step, b)) < 0) {
           const double t = root_in([&](double s) { return value(w, advance(step, s)); }, a, b);
           if (!exit || t < exit->tau) exit = Exit{t, w, false};
         }
