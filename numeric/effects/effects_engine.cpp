@@ -399,6 +399,8 @@ void Engine::transition(const Exit& exit, const Mode& m) {
       break;
     case Guard::ZoneExit:
       break;  // the teeth no longer overlap: the engagement guard changes, nothing happens
+    case Guard::Handover:
+      break;  // never an exit of a segment (effects_stribeck.cpp)
   }
 }
 

@@ -42,6 +42,8 @@ enum class Guard {
   EngageFace,      // free, compliant: −δ_φ ≥ 0 (teeth apart)
   EngageForce,     // free, compliant, teeth overlapping: −P_φ ≥ 0
   ZoneExit,        // free, compliant, teeth overlapping: δ_φ ≥ 0
+  Handover,        // Stribeck: a slipping body's speed crossing the level where its drop saturates
+                   // (effects_stribeck.cpp); it ends a segment, never an event of the engine
 };
 
 /// row·z + constant + drive_weight·D(t) in a mode's local coordinates; `magnitude` is the size
@@ -145,6 +147,12 @@ class Engine {
   bool stop_reached_ = false;  ///< the event of engine_.stop_at_kind / stop_at_face happened
   std::deque<double> impacts_;
 };
+
+/// The closed-form segment of mode `m` from `start` (effects_simulation.cpp) with `extra` guards
+/// besides the mode's own (Handover guards: their exit ends the segment without an exit).
+std::unique_ptr<Segment> closed_form_segment(const Parameters& p, const Effects& e, const Mode& m,
+                                             const HybridState& start, double horizon, double t_global,
+                                             const std::vector<Witness>& extra);
 
 /// Stribeck friction (dopri5 with exact event semantics): effects_stribeck.cpp.
 SimulationResult simulate_stribeck(const Parameters& p, const Effects& e, const HybridState& start,

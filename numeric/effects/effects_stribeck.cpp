@@ -1,6 +1,6 @@
 // Stribeck friction (docs/effects.md, "Stribeck friction"): a moving body's friction is
 // s·(Tk + (Ts − Tk)·exp(−(v/vs)²)) on top of its Coulomb torque, nonlinear in its velocity, so a
-// mode has no closed form.  The engine (effects_engine.cpp) keeps its mode logic — static
+// mode has no closed form at low speeds.  The engine (effects_engine.cpp) keeps its mode logic — static
 // rules, impacts, restitution, transitions, rest — and runs with each body's Coulomb torque at
 // its STATIC level T + Ts (exact wherever a body is at rest: sticking, break-away, the pair's
 // band); a moving body's friction lies below that level by the drop
@@ -15,7 +15,12 @@
 //     and refined with Boost.Math's toms748 on exact values — one dopri5 step of the exact
 //     length from the accepted step's start, as every state the engine reads (so the state
 //     at an event carries the integrator's own error, one step's, not an interpolation's);
-//   – a run tries at most kMaxSteps steps, then work_limit (exit 3).
+//   – a run tries at most kMaxSteps steps, then work_limit (exit 3);
+//   – where every slipping Stribeck body's drop has saturated to Ts − Tk in double precision
+//     (|v| ≥ √40·vs), and where no Stribeck body slips, the mode IS linear: the engine's
+//     closed-form segment at the kinetic level (effects_simulation.cpp) with a Handover guard
+//     per body at |v| = √40·vs, whose exit ends the segment (no event); the integration takes
+//     over there, up to |v| = √50·vs (StribeckEngine::next_segment).
 // The odeint simulator (odeint_effects_simulation.cpp) is an independent implementation.
 #include "effects/effects_engine.hpp"
 
@@ -70,7 +75,7 @@ double root_in(const std::function<double(double)>& f, double a, double b) {
 class StribeckSegment final : public Segment {
  public:
   StribeckSegment(const Parameters& p, const Effects& level, const Effects& e, const Mode& m, const HybridState& start,
-                  double horizon, double t_global, Budget& budget)
+                  double horizon, double t_global, Budget& budget, const std::vector<Witness>& handovers)
       : p_(p), e_(e), flow_(p, level, m, start), n_(static_cast<int>(flow_.segment().A.rows())) {
     duration = horizon;
     if (m.kind == ModeKind::Contact ? m.slip_motor == 0 : (m.slip_motor == 0 && m.slip_load == 0)) {
@@ -78,8 +83,10 @@ class StribeckSegment final : public Segment {
       return;
     }
     witnesses_ = mode_witnesses(p, level, m, functionals(level), true);
+    witnesses_.insert(witnesses_.end(), handovers.begin(), handovers.end());
     integrate(horizon, t_global, budget);
     if (exit) duration = exit->tau;
+    if (exit && exit->witness.guard == Guard::Handover) exit.reset();  // the segment ends there, the mode goes on
   }
 
   HybridState state(double tau) const override { return flow_.state_of(local(z_at(tau))); }
@@ -324,7 +331,46 @@ class StribeckSegment final : public Segment {
   std::vector<Step> steps_;
 };
 
-// The engine at the static levels, the drops added by its segments.
+// Where the drop saturates (docs/effects.md, "Stribeck friction"): for |v| ≥ kSaturated·vs,
+// e^{−(v/vs)²} ≤ e^{−40} < 2^{−54}, so expm1 rounds to −1 and stribeck_drop is exactly Ts − Tk: the
+// integrated right-hand side IS the linear mode at the kinetic level T + Tk, which has a closed
+// form.  A segment hands over to the closed form when every slipping Stribeck body's speed is
+// ≥ kChoose·vs (the integration ends at kEnter·vs), and back when one falls to kSaturated·vs.
+const double kSaturated = std::sqrt(40.0), kChoose = std::sqrt(45.0), kEnter = std::sqrt(50.0);
+
+// A slipping body whose friction has a Stribeck drop: its velocity's coordinate and slip sign in
+// the mode, and its Stribeck velocity (rigid contact: the larger of the two bodies').
+struct SlippingCurve {
+  int index = 1, sign = 0;
+  double vs = 0;
+};
+
+std::vector<SlippingCurve> slipping_curves(const Effects& e, const Mode& m) {
+  auto vs_of = [&e](bool motor) {
+    const double drop = motor ? e.stribeck_motor_static - e.stribeck_motor_kinetic
+                              : e.stribeck_load_static - e.stribeck_load_kinetic;
+    return drop > 0 ? (motor ? e.stribeck_motor_velocity : e.stribeck_load_velocity) : 0.0;
+  };
+  std::vector<SlippingCurve> out;
+  if (m.kind == ModeKind::Contact) {
+    const double vs = std::max(vs_of(true), vs_of(false));
+    if (m.slip_motor != 0 && vs > 0) out.push_back({1, m.slip_motor, vs});
+    return out;
+  }
+  if (m.slip_motor != 0 && vs_of(true) > 0) out.push_back({1, m.slip_motor, vs_of(true)});
+  if (m.slip_load != 0 && vs_of(false) > 0) out.push_back({3, m.slip_load, vs_of(false)});
+  return out;
+}
+
+// The handover guard sign·(sign·v − k·vs) ≥ 0 in the mode's local coordinates (v = z[index]).
+Witness handover(const Mode& m, const SlippingCurve& c, double k, int sign) {
+  Functional f{SmallRow::Zero(m.kind == ModeKind::Contact ? 2 : 4), -sign * k * c.vs, k * c.vs, 0};
+  f.row(c.index) = sign * c.sign;
+  return Witness{Guard::Handover, 0, f};
+}
+
+// The engine at the static levels, the drops added by its segments; where every slipping body's
+// drop has saturated, the mode's closed form at the kinetic levels (effects_simulation.cpp).
 class StribeckEngine final : public Engine {
  public:
   StribeckEngine(const Parameters& p, const Effects& level, const Effects& e, const SimulationOptions& options,
@@ -336,11 +382,39 @@ class StribeckEngine final : public Engine {
     return drive_torque_in_regime(p_, e_, measured(p_, state_), state_.drive_regime);
   }
   std::unique_ptr<Segment> next_segment(const Mode& mode, double remaining) override {
-    return std::make_unique<StribeckSegment>(p_, e_, stribeck_, mode, state_, remaining, t_, budget_);
+    const std::vector<SlippingCurve> curves = slipping_curves(stribeck_, mode);
+    std::vector<Witness> floors, ceilings;
+    for (const SlippingCurve& c : curves) {
+      const double speed = c.sign * (c.index == 1 ? state_.dtheta_m : state_.dtheta_L);
+      if (speed >= kChoose * c.vs)
+        floors.push_back(handover(mode, c, kSaturated, 1));
+      else
+        ceilings.push_back(handover(mode, c, kEnter, -1));
+    }
+    if (ceilings.empty()) {  // no drop left to integrate (none slipping: the closed form throughout)
+      auto closed = closed_form_segment(p_, kinetic_level(mode), mode, state_, remaining, t_, floors);
+      if (closed->exit || closed->rest || closed->duration > 0) return closed;
+    }
+    auto integrated = std::make_unique<StribeckSegment>(p_, e_, stribeck_, mode, state_, remaining, t_, budget_, ceilings);
+    if (integrated->exit || integrated->rest || integrated->duration > 0 || ceilings.empty()) return integrated;
+    // A handover at once (rounding at a tiny vs): integrate without it, never an empty segment again.
+    return std::make_unique<StribeckSegment>(p_, e_, stribeck_, mode, state_, remaining, t_, budget_,
+                                             std::vector<Witness>{});
   }
   double friction_drop(bool motor, double velocity) const override { return stribeck_drop(stribeck_, motor, velocity); }
 
  private:
+  // The static levels with each slipping Stribeck body's Coulomb torque at its kinetic level T + Tk.
+  Effects kinetic_level(const Mode& m) const {
+    Effects level = e_;
+    const bool motor_slips = m.slip_motor != 0, load_slips = m.kind == ModeKind::Contact ? motor_slips : m.slip_load != 0;
+    if (motor_slips && stribeck_.stribeck_motor_static > stribeck_.stribeck_motor_kinetic)
+      level.coulomb_motor = stribeck_.coulomb_motor + stribeck_.stribeck_motor_kinetic;
+    if (load_slips && stribeck_.stribeck_load_static > stribeck_.stribeck_load_kinetic)
+      level.coulomb_load = stribeck_.coulomb_load + stribeck_.stribeck_load_kinetic;
+    return level;
+  }
+
   const Effects& stribeck_;
   Budget budget_;
 };

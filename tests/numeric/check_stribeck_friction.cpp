@@ -314,6 +314,28 @@ TEST(StribeckFriction, item5_engine_agrees_with_the_reference_simulator) {
   std::printf("largest event-time difference, engine against the reference: %.2e s\n", worst);
 }
 
+// A stiff undamped mesh (check_effects_boundaries' pair: stiffness 1e5, Stribeck on the motor):
+// the mesh rings at √(kc·(1/Jm + 1/JL)) ≈ 630 rad/s through some 30 separations and recontacts while the
+// motor slips far above its Stribeck velocity, where the drop has saturated in double precision and
+// the engine's segments are the closed forms at the kinetic level (effects_stribeck.cpp).  Those
+// agree with the reference to its own accuracy, 1e-9 s as above; integrating the ringing
+// mesh with dopri5 (the segments before) already missed the first separation by 1.8e-9 s.
+TEST(StribeckFriction, item5_saturated_drop_is_the_closed_form_on_a_stiff_mesh) {
+  const Parameters p = case_parameters("V");
+  Effects e = stribeck(true, 0.186, 0.0034, 0.0031);
+  e.mesh_stiffness = 1e5;
+  SimulationOptions o;
+  o.t_end = 1.33;  // the chattering amplifies any difference: later events differ by more than 1e-9 s
+  const SimulationResult engine = numeric::simulate_effects_step(model_of(p, e), 0.62, o, {.general_engine = true});
+  numeric::OdeintSimulationOptions reference;
+  reference.tolerance = 1e-13;
+  const SimulationResult odeint = numeric::simulate_effects_step_with_odeint(p, e, 0.62, o, reference);
+  ASSERT_GE(engine.events.size(), 30U) << describe(engine);
+  const double dt = expect_same_events(engine, odeint, 1e-9, 1e-8, "stiff mesh");
+  std::printf("stiff mesh, Stribeck on the motor: %zu events, max |dt| %.2e against the reference\n",
+              engine.events.size(), dt);
+}
+
 // ------------------------------------------------------------------ the case file
 
 const std::string case_v = R"(name = "V with Stribeck friction"
