@@ -1,7 +1,8 @@
 // time_ benchmarks of the effects (not timed tests): case V's step of 0.62 over 60 s,
 //   time_NominalClosedForm              the thesis's model on the closed forms (simulate_step);
 //   time_EffectsClosedForm/<effect>     with one effect, on the closed-form engine
-//                                       (simulate_effects_step; the delay by the method of steps);
+//                                       (simulate_effects_step; the delay by the method of steps;
+//                                       Stribeck friction integrated where its drop has not saturated);
 //   time_EffectsOdeint/<effect>         the same on the independent Boost.Odeint simulator at the
 //                                       tolerance the cross-check uses (1e-13: event times within
 //                                       ~4e-10 s of the closed form).
@@ -50,6 +51,9 @@ const std::vector<Effect>& effects() {
     add("compliance=400/4", [](numeric::Effects& e) { e.mesh_stiffness = 400, e.mesh_damping = 4; });
     add("delay=0.05", [](numeric::Effects& e) { e.delay = 0.05; });
     add("torque_offset=0.02", [](numeric::Effects& e) { e.torque_offset = 0.02; });
+    add("stribeck+mesh=1e5", [](numeric::Effects& e) {  // check_effects_boundaries' stiff pair
+      e.stribeck_motor_static = 0.186, e.stribeck_motor_velocity = 0.0031, e.mesh_stiffness = 1e5;
+    });
     return l;
   }();
   return list;
@@ -95,7 +99,7 @@ void time_EffectsClosedForm(benchmark::State& state) {
   }
   state.counters["events"] = static_cast<double>(events);
 }
-BENCHMARK(time_EffectsClosedForm)->DenseRange(0, 6)->Unit(benchmark::kMicrosecond);
+BENCHMARK(time_EffectsClosedForm)->DenseRange(0, 7)->Unit(benchmark::kMicrosecond);
 
 void time_EffectsOdeint(benchmark::State& state) {
   const Effect& e = effects()[static_cast<std::size_t>(state.range(0))];
@@ -106,7 +110,7 @@ void time_EffectsOdeint(benchmark::State& state) {
   odeint.tolerance = 1e-13;
   for (auto _ : state) benchmark::DoNotOptimize(numeric::simulate_effects_step_with_odeint(p, e.effects, step, o, odeint));
 }
-BENCHMARK(time_EffectsOdeint)->DenseRange(0, 6)->Unit(benchmark::kMicrosecond);
+BENCHMARK(time_EffectsOdeint)->DenseRange(0, 7)->Unit(benchmark::kMicrosecond);
 
 // Collects the per-effect times for the ratio table.
 class Ratios : public benchmark::ConsoleReporter {

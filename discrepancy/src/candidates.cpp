@@ -45,6 +45,7 @@ double scale_of(model::CandidateScale scale, const numeric::Parameters& p, doubl
     case model::CandidateScale::StepTorque: return p.K * std::fabs(step);  // the drive at the start of the step
     case model::CandidateScale::Gain: return p.K;
     case model::CandidateScale::ServoPeriod: return numeric::servo_period(p);
+    case model::CandidateScale::StepVelocity: return std::fabs(step) / numeric::servo_period(p);
     case model::CandidateScale::Absolute:
     case model::CandidateScale::DampingRatio: return 1;
   }

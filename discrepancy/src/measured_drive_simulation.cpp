@@ -192,6 +192,8 @@ RigidDrive rigid_drive_of(const numeric::Parameters& p, const numeric::Effects& 
     if (effect.needs_gap && e.has(effect))
       refuse(prefix, effect.single() ? "" : std::string(effect.key) + ": ", effect.primary().name, " = ",
              model::field(e, effect.primary().id), " needs a gap to close (backlash > 0); a rigid drive has none");
+  if (e.stribeck())
+    refuse(prefix, "Stribeck friction (", e.describe(), ") is not simulated on a rigid measured drive; use coulomb_motor");
   RigidDrive m;
   m.J = p.Jm + p.JL;
   m.F = p.Fm + p.FL;

@@ -485,6 +485,20 @@ class CaseFileReader {
       const toml::node& node = require(table, prefix, table_line, parameter.key);
       field(effects, parameter.id) = read_effect_parameter(node, parameter, dotted(prefix, parameter.key));
     }
+    check_levels(table, effect, prefix, table_line, effects);
+  }
+
+  /// A friction with a `static` and a `kinetic` level (Stribeck) needs kinetic <= static.
+  void check_levels(const toml::table& table, const EffectInfo& effect, const std::string& prefix, long table_line,
+                    const Effects& effects) const {
+    const std::optional<Rational>*kinetic = nullptr, *level = nullptr;
+    for (std::size_t i = effect.first; i < effect.first + effect.count; ++i) {
+      if (effect_parameters[i].key == "kinetic") kinetic = &field(effects, effect_parameters[i].id);
+      if (effect_parameters[i].key == "static") level = &field(effects, effect_parameters[i].id);
+    }
+    if (kinetic && level && **kinetic > **level)
+      fail(line_of(*table.get("kinetic"), table_line), dotted(prefix, "kinetic"),
+           "the kinetic friction level must be <= the static one (" + dotted(prefix, "static") + ")");
   }
 
   /// [effects] (docs/effects.md): every entry optional, exact, checked by the table of effects

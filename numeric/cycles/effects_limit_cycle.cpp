@@ -606,7 +606,7 @@ void without_cycle(const ValidatedEffectModel& model, const std::vector<Iteratio
   if (cycle.status == CycleStatus::None && all_rest) {
     cycle.rest_error = rest_error;
     reason << "every seed comes to rest ("
-           << (model.effects().coulomb() ? "the Coulomb dead band stops the motion; " : "") << "final error "
+           << (model.effects().coulomb() || model.effects().stribeck() ? "the Coulomb dead band stops the motion; " : "") << "final error "
            << rest_error << ")";
   } else {
     if (cycle.status == CycleStatus::None) reason << "no stable cycle: ";

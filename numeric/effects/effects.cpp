@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 namespace backlash::numeric {
 
@@ -38,6 +39,32 @@ Effects effects_of(const model::CaseSpec& spec) {
     if (const std::optional<model::Rational>& value = model::field(spec.effects, parameter.id))
       model::field(e, parameter.id) = model::to_double(*value);
   return e;
+}
+
+double static_friction(const Effects& e, bool motor) {
+  return motor ? e.coulomb_motor + e.stribeck_motor_static : e.coulomb_load + e.stribeck_load_static;
+}
+
+namespace {
+// The Stribeck curve's drop Ts − Tk and velocity vs of a body.
+std::pair<double, double> stribeck_curve(const Effects& e, bool motor) {
+  return motor ? std::pair{e.stribeck_motor_static - e.stribeck_motor_kinetic, e.stribeck_motor_velocity}
+               : std::pair{e.stribeck_load_static - e.stribeck_load_kinetic, e.stribeck_load_velocity};
+}
+}  // namespace
+
+double stribeck_drop(const Effects& e, bool motor, double v) {
+  const auto [drop, vs] = stribeck_curve(e, motor);
+  if (!(drop > 0)) return 0;
+  const double x = v / vs;
+  return -drop * std::expm1(-x * x);  // (Ts − Tk)(1 − e^{−x²}), accurate for small x
+}
+
+double stribeck_drop_rate(const Effects& e, bool motor, double v) {
+  const auto [drop, vs] = stribeck_curve(e, motor);
+  if (!(drop > 0)) return 0;
+  const double x = v / vs;
+  return drop * 2 * x / vs * std::exp(-x * x);
 }
 
 double drive_constant(const Effects& e, int regime) {

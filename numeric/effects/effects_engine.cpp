@@ -175,9 +175,10 @@ double Engine::load_static_torque(const HybridState& s) const {
 double Engine::contact_torque(const Mode& m, const HybridState& s) const {
   const double J = p_.Jm + p_.JL, F = p_.Fm + p_.FL, omega = s.dtheta_m;
   if (m.slip_motor == 0) return 0;
-  const double T = e_.coulomb_motor + e_.coulomb_load;
+  const double TL = e_.coulomb_load - friction_drop(false, omega);
+  const double T = e_.coulomb_motor - friction_drop(true, omega) + TL;
   const double acceleration = (drive_now() - F * omega - T * m.slip_motor) / J;
-  return p_.JL * acceleration + p_.FL * omega + e_.coulomb_load * m.slip_motor;
+  return p_.JL * acceleration + p_.FL * omega + TL * m.slip_motor;
 }
 
 Mode Engine::mode_of(const HybridState& s) const {
@@ -266,9 +267,10 @@ bool Engine::contact_holds(const HybridState& s) const {
 // back together (free-flight torques); α > 0 makes the bounces that follow a converging series.
 double Engine::closing_acceleration(int face) const {
   const Mode m = mode_of(state_);
-  const double motor = m.slip_motor == 0 ? 0.0
-                                         : (drive_now() - p_.Fm * state_.dtheta_m - e_.coulomb_motor * m.slip_motor) / p_.Jm;
-  const double load = m.slip_load == 0 ? 0.0 : (-p_.FL * state_.dtheta_L - e_.coulomb_load * m.slip_load) / p_.JL;
+  const double Tm = e_.coulomb_motor - friction_drop(true, state_.dtheta_m);
+  const double TL = e_.coulomb_load - friction_drop(false, state_.dtheta_L);
+  const double motor = m.slip_motor == 0 ? 0.0 : (drive_now() - p_.Fm * state_.dtheta_m - Tm * m.slip_motor) / p_.Jm;
+  const double load = m.slip_load == 0 ? 0.0 : (-p_.FL * state_.dtheta_L - TL * m.slip_load) / p_.JL;
   return face * (load - motor);
 }
 
@@ -397,6 +399,8 @@ void Engine::transition(const Exit& exit, const Mode& m) {
       break;
     case Guard::ZoneExit:
       break;  // the teeth no longer overlap: the engagement guard changes, nothing happens
+    case Guard::Handover:
+      break;  // never an exit of a segment (effects_stribeck.cpp)
   }
 }
 

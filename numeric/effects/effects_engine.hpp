@@ -42,6 +42,8 @@ enum class Guard {
   EngageFace,      // free, compliant: −δ_φ ≥ 0 (teeth apart)
   EngageForce,     // free, compliant, teeth overlapping: −P_φ ≥ 0
   ZoneExit,        // free, compliant, teeth overlapping: δ_φ ≥ 0
+  Handover,        // Stribeck: a slipping body's speed crossing the level where its drop saturates
+                   // (effects_stribeck.cpp); it ends a segment, never an event of the engine
 };
 
 /// row·z + constant + drive_weight·D(t) in a mode's local coordinates; `magnitude` is the size
@@ -106,6 +108,9 @@ class Engine {
   virtual std::unique_ptr<Segment> next_segment(const Mode& mode, double remaining) = 0;
   /// Called after every event and segment (the delayed model records its history).
   virtual void advanced(double /*t_from*/, const Segment* /*segment*/) {}
+  /// How far a slipping body's friction at velocity v lies below the level e_ gives it (Stribeck
+  /// friction, effects_stribeck.cpp, where e_ carries the static level); 0 for Coulomb friction.
+  virtual double friction_drop(bool /*motor*/, double /*velocity*/) const { return 0; }
 
   Mode mode_of(const HybridState& s) const;
   double motor_static_torque(const HybridState& s) const;
@@ -142,6 +147,16 @@ class Engine {
   bool stop_reached_ = false;  ///< the event of engine_.stop_at_kind / stop_at_face happened
   std::deque<double> impacts_;
 };
+
+/// The closed-form segment of mode `m` from `start` (effects_simulation.cpp) with `extra` guards
+/// besides the mode's own (Handover guards: their exit ends the segment without an exit).
+std::unique_ptr<Segment> closed_form_segment(const Parameters& p, const Effects& e, const Mode& m,
+                                             const HybridState& start, double horizon, double t_global,
+                                             const std::vector<Witness>& extra);
+
+/// Stribeck friction (dopri5 with exact event semantics): effects_stribeck.cpp.
+SimulationResult simulate_stribeck(const Parameters& p, const Effects& e, const HybridState& start,
+                                   const SimulationOptions& options, const EffectsEngineOptions& engine);
 
 /// The delayed model (Boost.Odeint, method of steps): effects_delay.cpp.
 SimulationResult simulate_delayed(const Parameters& p, const Effects& e, const HybridState& start,

@@ -164,7 +164,7 @@ class ExitSearch {
 class ClosedFormSegment final : public detail::Segment {
  public:
   ClosedFormSegment(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start, double horizon,
-                    double t_global)
+                    double t_global, const std::vector<Witness>& extra = {})
       : params_(p), flow_(p, e, m, start) {
     duration = horizon;
     if (m.kind == ModeKind::Contact ? m.slip_motor == 0 : (m.slip_motor == 0 && m.slip_load == 0)) {
@@ -174,11 +174,13 @@ class ClosedFormSegment final : public detail::Segment {
     // Every witness searched window by window, the windows doubling from an eighth of the servo
     // period: the search stops at the first window that holds an exit, never far beyond it.
     std::vector<ExitSearch> searches;
-    for (const Witness& w : detail::mode_witnesses(p, e, m, functionals_of(p, e, flow_), true)) {
+    std::vector<Witness> witnesses = detail::mode_witnesses(p, e, m, functionals_of(p, e, flow_), true);
+    witnesses.insert(witnesses.end(), extra.begin(), extra.end());
+    for (const Witness& w : witnesses) {
       searches.emplace_back(p, flow_, w, horizon, t_global);
       if (searches.back().immediate()) {
-        exit = Exit{0, w, false};
         duration = 0;
+        if (w.guard != Guard::Handover) exit = Exit{0, w, false};  // a handover at once: an empty segment
         return;
       }
     }
@@ -191,6 +193,7 @@ class ClosedFormSegment final : public detail::Segment {
       }
     }
     if (exit) duration = exit->tau;
+    if (exit && exit->witness.guard == Guard::Handover) exit.reset();  // the segment ends there, the mode goes on
   }
 
   HybridState state(double tau) const override { return flow_.state(tau); }
@@ -242,10 +245,17 @@ class ClosedFormEngine final : public detail::Engine {
 
 }  // namespace
 
+std::unique_ptr<detail::Segment> detail::closed_form_segment(const Parameters& p, const Effects& e, const Mode& m,
+                                                             const HybridState& start, double horizon,
+                                                             double t_global, const std::vector<Witness>& extra) {
+  return std::make_unique<ClosedFormSegment>(p, e, m, start, horizon, t_global, extra);
+}
+
 SimulationResult simulate_effects(const ValidatedEffectModel& model, const HybridState& start,
                                   const SimulationOptions& options, const EffectsEngineOptions& engine) {
   const Effects& e = model.effects();
   if (!e.any() && !engine.general_engine) return simulate(model.nominal(), start, options);
+  if (e.stribeck()) return detail::simulate_stribeck(model.parameters(), e, start, options, engine);
   if (e.delayed()) return detail::simulate_delayed(model.parameters(), e, start, options, engine);
   return ClosedFormEngine(model.parameters(), e, options, engine).run(start);
 }

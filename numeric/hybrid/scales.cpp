@@ -113,11 +113,42 @@ std::optional<std::string> effect_value_problem(const Effects& e) {
   return std::nullopt;
 }
 
+// Stribeck friction on each body (docs/effects.md, "Stribeck friction"): kinetic ≤ static, the
+// curve's steepest slope held to max_stiffness like a mode's rate, no delay with it.
+std::optional<std::string> stribeck_problem(const Parameters& p, const Effects& e, double slowest) {
+  struct Body {
+    const char* key;
+    double Ts, Tk, vs, J;
+  };
+  for (const Body& b : {Body{"stribeck_motor", e.stribeck_motor_static, e.stribeck_motor_kinetic,
+                             e.stribeck_motor_velocity, p.Jm},
+                        Body{"stribeck_load", e.stribeck_load_static, e.stribeck_load_kinetic, e.stribeck_load_velocity,
+                             p.JL}}) {
+    const std::string key = b.key;
+    if (b.Tk > b.Ts)
+      return key + ".kinetic = " + number(b.Tk) + " is above " + key + ".static = " + number(b.Ts) +
+             ": the kinetic friction level must be <= the static one";
+    if (!(b.Ts > 0)) continue;
+    if (e.delayed())
+      return key + " with delay = " + number(e.delay) +
+             ": the delayed model has no Stribeck friction (docs/effects.md); give one of them";
+    // |d/dv| of (Ts − Tk)·e^{−(v/vs)²} is at most sqrt(2/e)·(Ts − Tk)/vs: a negative damping rate.
+    const double rate = std::sqrt(2 / M_E) * (b.Ts - b.Tk) / (b.vs * b.J), stiffness = rate * slowest;
+    if (!std::isfinite(stiffness) || stiffness > max_stiffness)
+      return key + ".velocity = " + number(b.vs) + ": time scales too far apart: the Stribeck curve's steepest " +
+             "rate, " + number(rate) + "/s (0.858 (static - kinetic)/(velocity J)), times the slowest time scale, " +
+             number(slowest) + " s, is " + number(stiffness) + " > " + number(max_stiffness) +
+             ": no integration can span it in double precision";
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::optional<std::string> effect_scale_problem(const Parameters& p, const Effects& e) {
   if (auto problem = effect_value_problem(e)) return problem;
   const double slowest = slowest_time_scale(p);
+  if (auto problem = stribeck_problem(p, e, slowest)) return problem;
   if (e.compliant()) {
     // The engaged mesh is a mode like the others: its rate against the slowest time scale.
     const double m = 1 / p.Jm + 1 / p.JL, spring = std::sqrt(e.mesh_stiffness * m), damper = e.mesh_damping * m;

@@ -52,6 +52,11 @@
 // (and of t = 0): a jump of the m-th derivative of θo at t_s is one of order m + 2k
 // at t_s + kτ (m ≥ 1, an impact), so beyond k = 4 it is below dopri5's order anyway.
 //
+// Stribeck friction: a moving body's friction level is Coulomb + Tk + (Ts − Tk)·exp(−(v/vs)²)
+// in every right-hand side, Tc and impact formula (Model::motor_friction, load_friction); the
+// static rules, the stuck bands and the breakaway witnesses use the static level Coulomb + Ts
+// (Model::Tm, TL).  Nothing else changes: the modes are integrated numerically anyway.
+//
 // Decisions where docs/effects.md is silent or needs a reading (reported):
 //  1. Rest "at the time the last body stuck": reported at the last event's time (the
 //     last stick, or a saturation switch while the delayed drive settles, so that event
@@ -221,14 +226,29 @@ struct Model {
   double J = 0, F = 0, mu = 0;  // J = Jm + JL, F = Fm + FL, μ = Jm·JL/J
   double Tm = 0, TL = 0, Tsum = 0, e = 0, L = kInfinity, kc = kInfinity, cc = 0, tau = 0, T0 = 0;
   bool at_motor = false, delayed = false, saturating = false, compliant = false;
+  // Stribeck friction (docs/effects.md): per body its Coulomb torque, kinetic and static levels
+  // and Stribeck velocity; Tm, TL above are the static levels (Coulomb + static), the band a
+  // body at rest sticks in.
+  bool stribeck = false;
+  double coulomb_m = 0, coulomb_L = 0, kinetic_m = 0, kinetic_L = 0, static_m = 0, static_L = 0;
+  double vs_m = kInfinity, vs_L = kInfinity;
   const History* history = nullptr;
 
   Model(const Parameters& parameters, const Effects& fx, const History* h) : p(parameters), history(h) {
     J = p.Jm + p.JL;
     F = p.Fm + p.FL;
     mu = p.Jm * p.JL / J;
-    Tm = fx.coulomb_motor;
-    TL = fx.coulomb_load;
+    coulomb_m = fx.coulomb_motor;
+    coulomb_L = fx.coulomb_load;
+    static_m = fx.stribeck_motor_static;
+    static_L = fx.stribeck_load_static;
+    kinetic_m = fx.stribeck_motor_kinetic;
+    kinetic_L = fx.stribeck_load_kinetic;
+    vs_m = fx.stribeck_motor_velocity;
+    vs_L = fx.stribeck_load_velocity;
+    stribeck = static_m > 0 || static_L > 0;
+    Tm = coulomb_m + static_m;
+    TL = coulomb_L + static_L;
     Tsum = Tm + TL;
     e = fx.restitution;
     saturating = fx.saturating();
@@ -240,6 +260,26 @@ struct Model {
     tau = fx.delay;
     T0 = fx.torque_offset;
     at_motor = p.measured_at == model::MeasuredAt::Motor;
+  }
+  /// The friction level of a moving body at velocity v: its Coulomb torque plus the Stribeck
+  /// curve Tk + (Ts − Tk)·exp(−(v/vs)²) (the static level Tm, TL without Stribeck friction).
+  double motor_friction(double v) const {
+    if (!stribeck) return Tm;
+    const double x = v / vs_m;
+    return coulomb_m + kinetic_m + (static_m - kinetic_m) * std::exp(-x * x);
+  }
+  double load_friction(double v) const {
+    if (!stribeck) return TL;
+    const double x = v / vs_L;
+    return coulomb_L + kinetic_L + (static_L - kinetic_L) * std::exp(-x * x);
+  }
+  /// d/dv of the pair's friction level, motor_friction + load_friction, and of the load's.
+  double pair_friction_slope(double v) const { return friction_slope(v, static_m - kinetic_m, vs_m) + load_friction_slope(v); }
+  double load_friction_slope(double v) const { return friction_slope(v, static_L - kinetic_L, vs_L); }
+  static double friction_slope(double v, double drop, double vs) {
+    if (!(drop > 0)) return 0;
+    const double x = v / vs;
+    return -2 * drop * x / vs * std::exp(-x * x);
   }
   /// K(θR − θo(t − τ)) from the history.
   double delayed_demand(double t) const { return p.K * (p.theta_R - history->value(t - tau)); }
@@ -282,19 +322,22 @@ struct ContactSystem {
   double drive(const Vec2& y, double tau) const { return m->drive(regime, demand(y, tau)); }
   double acceleration(const Vec2& y, double tau) const {
     if (stuck) return 0;
+    if (m->stribeck) return (drive(y, tau) - m->F * y[1] - friction(y[1]) * s) / m->J;
     if (linear_undelayed()) return (-m->p.K * y[0] - m->F * y[1]) / m->J;  // c absorbs T0 − (Tm+TL)s
     return (drive(y, tau) - m->F * y[1] - m->Tsum * s) / m->J;
   }
+  /// The pair's friction level at ω (Tm + TL without Stribeck friction).
+  double friction(double omega) const { return m->motor_friction(omega) + m->load_friction(omega); }
   /// Tc = JL·ω̇ + FL·ω + TL·s (the torque the motor transmits, its Coulomb part included).
   double transmitted(const Vec2& y, double tau) const {
-    return m->p.JL * acceleration(y, tau) + m->p.FL * y[1] + m->TL * s;
+    return m->p.JL * acceleration(y, tau) + m->p.FL * y[1] + m->load_friction(y[1]) * s;
   }
   double transmitted_rate(const Vec2& y, double tau) const {
     const double a = acceleration(y, tau);
     const double drive_rate =
         regime != 0 ? 0.0 : m->delayed ? m->delayed_demand_rate(t0 + tau) : -m->p.K * y[1];
-    const double jerk = (drive_rate - m->F * a) / m->J;
-    return m->p.JL * jerk + m->p.FL * a;
+    const double jerk = (drive_rate - m->F * a - m->pair_friction_slope(y[1]) * a * s) / m->J;
+    return m->p.JL * jerk + m->p.FL * a + m->load_friction_slope(y[1]) * a * s;
   }
   void operator()(const Vec2& y, Vec2& dy, double tau) const {
     dy[0] = stuck ? 0.0 : y[1];
@@ -332,8 +375,9 @@ struct TwoBodySystem {
   }
   void accelerations(const Vec4& y, double tau, double& am, double& aL) const {
     const double P = mesh != 0 ? mesh_force(y, mesh) : 0.0;
-    am = motor_stuck ? 0.0 : (drive(y, tau) - m->p.Fm * y[1] - m->Tm * s_m + mesh * P) / m->p.Jm;
-    aL = load_stuck ? 0.0 : (-m->p.FL * load_velocity(y) - m->TL * s_L - mesh * P) / m->p.JL;
+    am = motor_stuck ? 0.0 : (drive(y, tau) - m->p.Fm * y[1] - m->motor_friction(y[1]) * s_m + mesh * P) / m->p.Jm;
+    aL = load_stuck ? 0.0
+                    : (-m->p.FL * load_velocity(y) - m->load_friction(load_velocity(y)) * s_L - mesh * P) / m->p.JL;
   }
   void operator()(const Vec4& y, Vec4& dy, double tau) const {
     double am, aL;
@@ -1231,8 +1275,8 @@ std::optional<SimulationStatus> Simulator::bounce(int face_hit, EventKind kind) 
   const double D = drive_now();
   auto direction = [](double v, double n, double T) { return v != 0 ? sgn(v) : std::fabs(n) <= T ? 0 : sgn(n); };
   const int sm = direction(vm_after, D, m_.Tm), sL = direction(vL_after, 0.0, m_.TL);
-  const double am = (D - m_.p.Fm * vm_after - m_.Tm * sm) / Jm;
-  const double aL = (-m_.p.FL * vL_after - m_.TL * sL) / JL;
+  const double am = (D - m_.p.Fm * vm_after - m_.motor_friction(vm_after) * sm) / Jm;
+  const double aL = (-m_.p.FL * vL_after - m_.load_friction(vL_after) * sL) / JL;
   const double alpha = face_hit * (aL - am);
   const double w = m_.e * std::fabs(v_rel);
   // A bounce series continues when the event before this impact was a bounce on this face;
@@ -1259,7 +1303,7 @@ std::optional<SimulationStatus> Simulator::sum_bounce_series(int face_hit, doubl
   const int s = V != 0 ? sgn(V) : 0;
   st_ = state_on_face(m_.p, face_hit, theta_o, V, true);
   st_.drive_regime = regime;
-  const double acc = (drive_now() - m_.F * V - m_.Tsum * s) / m_.J;
+  const double acc = (drive_now() - m_.F * V - (m_.motor_friction(V) + m_.load_friction(V)) * s) / m_.J;
   const double theta_after = theta_o + V * tau_inf + 0.5 * acc * tau_inf * tau_inf;
   const double omega_after = V + acc * tau_inf;
   if (m_.delayed) history_.push(t_, t_ + tau_inf, Jet{theta_o, V, acc}, Jet{theta_after, omega_after, acc});
@@ -1303,15 +1347,15 @@ std::optional<SimulationStatus> Simulator::inelastic_impact(int face_hit, EventK
     return std::nullopt;
   }
   const int s = sgn(V);
-  const double acc = (drive_now() - m_.F * V - m_.Tsum * s) / J;
-  const double tc = JL * acc + m_.p.FL * V + m_.TL * s;
+  const double acc = (drive_now() - m_.F * V - (m_.motor_friction(V) + m_.load_friction(V)) * s) / J;
+  const double tc = JL * acc + m_.p.FL * V + m_.load_friction(V) * s;
   bool holds = -face_hit * tc >= -1e-14 * std::max(1.0, std::fabs(tc));
   if (!holds && std::fabs(tc) <= 1e-13 * std::max(1.0, std::fabs(V))) {
     // Tc at rounding level (an impact right at the separation line; with b = 0 every
     // separation is one): where it is heading decides, as at the start of a contact.
     const double drive_rate = regime != 0 ? 0.0 : m_.delayed ? m_.delayed_demand_rate(t_) : -m_.p.K * V;
-    const double jerk = (drive_rate - m_.F * acc) / J;
-    holds = -face_hit * (JL * jerk + m_.p.FL * acc) > 0;
+    const double jerk = (drive_rate - m_.F * acc - m_.pair_friction_slope(V) * acc * s) / J;
+    holds = -face_hit * (JL * jerk + m_.p.FL * acc + m_.load_friction_slope(V) * acc * s) > 0;
   }
   s_m_ = s_L_ = s;
   if (!holds) st_.in_contact = false;  // a bounce: the bodies part again at once

@@ -210,10 +210,14 @@ TEST(ApiErrors, OneLineNamingTheArgument) {
                "set by its damping); give one of them");
   expect_error("from_texts with Jx", error_of([] { api::Case::from_texts({{"Jx", "1"}}); }),
                "Jx: unknown parameter (allowed: name measured_at K backlash reference Jm Fm JL FL experiment step t_end "
-               "drive_gain coulomb_motor coulomb_load restitution saturation stiffness damping delay torque_offset)");
+               "drive_gain coulomb_motor coulomb_load restitution saturation stiffness damping delay torque_offset "
+               "stribeck_motor_static stribeck_motor_kinetic stribeck_motor_velocity stribeck_load_static "
+               "stribeck_load_kinetic stribeck_load_velocity)");
   expect_error("sweep(vary = Q)", error_of([] { api::sweep({.target = "V", .vary = "Q", .from = 0, .to = 1, .points = 2}); }),
                "vary: unknown parameter 'Q' (Jm, Fm, JL, FL, K, backlash, reference, JL_over_Jm, FL_over_F, "
-               "coulomb_motor, coulomb_load, restitution, saturation, stiffness, damping, delay, torque_offset)");
+               "coulomb_motor, coulomb_load, restitution, saturation, stiffness, damping, delay, torque_offset, "
+               "stribeck_motor_static, stribeck_motor_kinetic, stribeck_motor_velocity, stribeck_load_static, "
+               "stribeck_load_kinetic, stribeck_load_velocity)");
   expect_error("sweep(points = 0)", error_of([] { api::sweep({.target = "fig31", .points = 0}); }),
                "points: expected an integer >= 1, got 0");
   expect_error("validate(tolerance = 0)", error_of([] { api::validate(api::load("V"), false, 0); }),

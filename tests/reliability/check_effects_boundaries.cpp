@@ -91,6 +91,7 @@ double scale_of(const EffectParameterInfo& p, double stiffness) {
     case model::CandidateScale::StepTorque: return K * kStep;
     case model::CandidateScale::Gain: return K;
     case model::CandidateScale::ServoPeriod: return 2 * std::numbers::pi * std::sqrt((Jm + JL) / K);
+    case model::CandidateScale::StepVelocity: return kStep / (2 * std::numbers::pi * std::sqrt((Jm + JL) / K));
     case model::CandidateScale::Absolute: return 1;
     case model::CandidateScale::DampingRatio: return 2 * std::sqrt(stiffness * Jm * JL / (Jm + JL));
   }

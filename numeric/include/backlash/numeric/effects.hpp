@@ -9,6 +9,9 @@
 //                      kc·δ + cc·δ̇ beyond ±b/2, never pulls
 //   delay              τ ≥ 0 [s]: the fed-back angle is θo(t − τ)
 //   torque offset      T0 [torque]: a constant torque on the motor shaft
+//   Stribeck friction  Ts ≥ Tk ≥ 0 [torque], vs > 0 [rad/s] on either body: a moving body's
+//                      friction −s·(Tk + (Ts − Tk)·exp(−(v/vs)²)), added to its Coulomb torque;
+//                      a body at rest stays stuck while the torque on it is within ±(T + Ts)
 // Every effect at its neutral value (0, no limit, a rigid mesh) is the nominal model.
 #pragma once
 
@@ -37,6 +40,7 @@ struct Effects {
   bool compliant() const { return std::isfinite(mesh_stiffness); }
   bool coulomb() const { return coulomb_motor > 0 || coulomb_load > 0; }
   bool delayed() const { return delay > 0; }
+  bool stribeck() const { return stribeck_motor_static > 0 || stribeck_load_static > 0; }
   /// True when the effect is present: its first parameter not neutral.
   bool has(const model::EffectInfo& effect) const;
   /// True when some effect differs from its neutral value.
@@ -45,6 +49,15 @@ struct Effects {
   /// its table NAME; "none" when nominal).
   std::string describe() const;
 };
+
+/// Stribeck friction (docs/effects.md, "Stribeck friction") on the motor (`motor`) or the load:
+/// the static level, the body's Coulomb torque plus its Stribeck Ts (a body at rest sticks while
+/// the torque on it is within ±static_friction) ...
+double static_friction(const Effects& e, bool motor);
+/// ... and the drop of a moving body's friction below it at velocity v,
+/// (Ts − Tk)·(1 − exp(−(v/vs)²)) ≥ 0 (0 at rest, Ts − Tk as |v| ≫ vs), with its derivative d/dv.
+double stribeck_drop(const Effects& e, bool motor, double v);
+double stribeck_drop_rate(const Effects& e, bool motor, double v);
 
 /// The constant part of the drive torque in a saturation regime (0 linear, ±1 clipped at ±L):
 /// regime·L + T0 (the linear part, K·(θR − θo), is added by the mode).
