@@ -98,6 +98,7 @@ int main(int argument_count, char** arguments) {
   backlash::cli::register_import_command(app);
   backlash::cli::register_discrepancy_command(app);
   backlash::cli::register_map_command(app);
+  backlash::cli::register_explorer_command(app);
   refuse_empty_out(app);
   guard_standard_streams();
   backlash::output::clean_up_on_signals();
