@@ -1,3 +1,4 @@
+cmake_minimum_required(VERSION 3.25)
 # The explorer page as one file (cmake -P): the template web/index.html with the thesis's case
 # files (CASES: id → the file's text), the core (emcc's JavaScript with the wasm embedded) and
 # the page's JavaScript inlined.  -DTEMPLATE -DPAGE_JS -DCORE_JS -DCASES_DIR -DOUT.

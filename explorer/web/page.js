@@ -28,7 +28,9 @@
     parent.appendChild(row);
     const field = $("f_" + name), slider = $("s_" + name);
     field.addEventListener("input", () => scheduleUpdate(name));
-    slider.addEventListener("input", () => { field.value = Number(slider.value).toPrecision(6).replace(/\.?0+$/, ""); scheduleUpdate(name); });
+    // While a slider moves the portrait follows it; the live slice (25 limit cycles) follows on release.
+    slider.addEventListener("input", () => { S.sliding = true; field.value = String(+Number(slider.value).toPrecision(6)); scheduleUpdate(name); });
+    slider.addEventListener("change", () => { S.sliding = false; if ($("slice_live").checked && S.loaded) computeSlice(); });
   }
   for (const [name, label] of PARAMS) makeRow($("fields"), name, label);
   for (const e of EFFECTS) makeRow($("effects"), e.name, `${e.description} [${e.unit}]`);
@@ -104,17 +106,21 @@
   function update() {
     const t0 = performance.now();
     const loaded = JSON.parse(core.load_case(JSON.stringify(pairs())));
+    S.timings.load_ms = performance.now() - t0;
     clearErrors();
     if (!loaded.ok) return showError(loaded);
     const portrait = JSON.parse(core.portrait());
     if (!portrait.ok) return showError(portrait);
-    const step = $("f_step").value.trim() !== "" ? JSON.parse(core.step_response(0.02)) : null;
+    // ~800 samples a run: the drawing's resolution (the events, exact, come apart from the samples).
+    const tEnd = Number($("f_t_end").value) || 60;
+    const step = $("f_step").value.trim() !== "" ? JSON.parse(core.step_response(tEnd / 800)) : null;
     if (step && !step.ok) return showError(step);
     S.loaded = loaded; S.portrait = portrait; S.step = step;
     S.trajectories = S.trajectories.map((t) => runFrom(t.start)).filter((t) => t.ok);
+    S.timings.compute_ms = performance.now() - t0;
     if (!S.view) S.view = defaultView();
     draw();
-    if ($("slice_live").checked) computeSlice();
+    if ($("slice_live").checked && !S.sliding) computeSlice();
     S.timings.update_ms = performance.now() - t0;
     S.redraws++;
     statusLine();
@@ -122,7 +128,7 @@
 
   function runFrom(start) {
     const t_end = Number($("traj_t_end").value) || 60;
-    const r = JSON.parse(core.trajectory(start.theta_o, start.dtheta_o, start.flight, t_end, t_end / 3000));
+    const r = JSON.parse(core.trajectory(start.theta_o, start.dtheta_o, start.flight, t_end, t_end / 800));
     r.start = start;
     return r;
   }
@@ -138,7 +144,8 @@
     const last = S.trajectories[S.trajectories.length - 1];
     if (last) text += `last trajectory: ${last.simulation.status}, ${last.simulation.events.length} events, ${last.ms.toFixed(2)} ms` +
       (last.stop_message ? `\n${last.stop_message}` : "") + "\n";
-    text += `redraw ${S.timings.update_ms?.toFixed(1)} ms (portrait ${S.portrait.ms.toFixed(1)} ms)`;
+    text += `redraw ${S.timings.update_ms?.toFixed(1)} ms: model ${S.timings.load_ms?.toFixed(1)} ms, portrait ` +
+      `${S.portrait.ms.toFixed(1)} ms, runs ${(S.timings.compute_ms - S.timings.load_ms - S.portrait.ms).toFixed(1)} ms, drawing ${S.timings.draw_ms?.toFixed(1)} ms`;
     setStatus(text, false);
   }
 
@@ -153,7 +160,10 @@
     const mx = 0.06 * (x1 - x0), my = 0.08 * (y1 - y0);
     return { x0: x0 - mx, x1: x1 + mx, y0: y0 - my, y1: y1 + my };
   }
-  function box() { const r = $("plane").getBoundingClientRect(); return { w: r.width, h: r.height, left: r.left, top: r.top }; }
+  /// The plane's box, measured once per drawing (a layout query per point would cost more than the core).
+  let planeBox = null;
+  function measureBox() { const r = $("plane").getBoundingClientRect(); planeBox = { w: r.width, h: r.height, left: r.left, top: r.top }; return planeBox; }
+  function box() { return planeBox || measureBox(); }
   const PAD = { l: 52, r: 10, t: 10, b: 30 };
   function toPixel(x, y) {
     const { w, h } = box(), v = S.view;
@@ -163,7 +173,7 @@
     const { w, h } = box(), v = S.view;
     return [v.x0 + (px - PAD.l) / (w - PAD.l - PAD.r) * (v.x1 - v.x0), v.y0 + (h - PAD.b - py) / (h - PAD.t - PAD.b) * (v.y1 - v.y0)];
   }
-  S.toClient = (x, y) => { const [px, py] = toPixel(x, y), b = box(); return [b.left + px, b.top + py]; };
+  S.toClient = (x, y) => { const b = measureBox(), [px, py] = toPixel(x, y); return [b.left + px, b.top + py]; };
 
   function el(parent, name, attrs, text) {
     const e = document.createElementNS(SVGNS, name);
@@ -193,7 +203,9 @@
   }
 
   function draw() {
-    const svg = $("plane"), { w, h } = box(), v = S.view, p = S.loaded.parameters;
+    const t0 = performance.now();
+    const svg = $("plane"), { w, h } = measureBox(), v = S.view, p = S.loaded.parameters;
+    const timeBox = $("timeplot").getBoundingClientRect();  // measured before the drawing changes the layout
     svg.innerHTML = "";
     svg.setAttribute("viewBox", `0 0 ${w} ${h}`);
     el(svg, "rect", { width: w, height: h, fill: "white" });
@@ -214,8 +226,9 @@
     S.trajectories.forEach((t, i) => drawRun(g, t, COLORS[i % COLORS.length], 1.6));
     el(g, "circle", { cx: toPixel(R, 0)[0], cy: toPixel(R, 0)[1], r: 3, fill: "#000" });
     legend();
-    drawTime();
+    drawTime(timeBox);
     drawEvents();
+    S.timings.draw_ms = performance.now() - t0;
   }
   function drawDividingLines(g) {  // trace: recombination (or recontact) states after the impact, per sign of θ̇m0
     const pts = S.portrait.trace.points.filter((q) => q.theta_o !== null);
@@ -246,8 +259,8 @@
   }
 
   // ------------------------------------------------------------------ the time panel and the events
-  function drawTime() {
-    const svg = $("timeplot"), r = svg.getBoundingClientRect(), w = r.width, h = r.height;
+  function drawTime(r) {
+    const svg = $("timeplot"), w = r.width, h = r.height;
     svg.innerHTML = "";
     const run = S.trajectories[S.trajectories.length - 1] || S.step;
     if (!run || w === 0) return;
@@ -266,7 +279,8 @@
   }
   function drawEvents() {
     const run = S.trajectories[S.trajectories.length - 1] || S.step;
-    if (!run) return;
+    if (!run || run === S.eventsShown) return;  // the table is rebuilt only for another run
+    S.eventsShown = run;
     const sim = run.simulation;
     $("traj_info").textContent = S.trajectories.length ? `from θo = ${run.start.theta_o}, θ̇o = ${run.start.dtheta_o}` +
       ` (${run.start.flight ? "free flight" : "contact"}): ${sim.status}` : `(step response): ${sim.status}`;
@@ -282,7 +296,7 @@
   const plane = $("plane");
   plane.addEventListener("mousedown", (ev) => { drag = { x: ev.clientX, y: ev.clientY, view: { ...S.view }, moved: false }; });
   plane.addEventListener("mousemove", (ev) => {
-    const b = box(), [x, y] = fromPixel(ev.clientX - b.left, ev.clientY - b.top);
+    const b = measureBox(), [x, y] = fromPixel(ev.clientX - b.left, ev.clientY - b.top);
     $("readout").textContent = `θo = ${x.toPrecision(6)}  θ̇o = ${y.toPrecision(6)}`;
     if (!drag) return;
     const dx = ev.clientX - drag.x, dy = ev.clientY - drag.y;
@@ -296,12 +310,12 @@
     const wasDrag = drag && drag.moved;
     drag = null;
     if (wasDrag || !S.loaded) return;
-    const b = box(), [x, y] = fromPixel(ev.clientX - b.left, ev.clientY - b.top);
+    const b = measureBox(), [x, y] = fromPixel(ev.clientX - b.left, ev.clientY - b.top);
     launch({ theta_o: x, dtheta_o: y, flight: $("flight").checked });
   });
   plane.addEventListener("wheel", (ev) => {
     ev.preventDefault();
-    const b = box(), [x, y] = fromPixel(ev.clientX - b.left, ev.clientY - b.top), f = ev.deltaY > 0 ? 1.15 : 1 / 1.15, v = S.view;
+    const b = measureBox(), [x, y] = fromPixel(ev.clientX - b.left, ev.clientY - b.top), f = ev.deltaY > 0 ? 1.15 : 1 / 1.15, v = S.view;
     S.view = { x0: x + (v.x0 - x) * f, x1: x + (v.x1 - x) * f, y0: y + (v.y0 - y) * f, y1: y + (v.y1 - y) * f };
     draw();
   }, { passive: false });

@@ -146,8 +146,8 @@ try {
   console.log(`MEASURED case V: 60 s trajectory from a click: ${trajectory.core.toFixed(2)} ms in the core, ${trajectory.wall.toFixed(2)} ms with the redraw`);
 
   // a bad value: the inline error naming the field, the drawing kept
-  const before = await evaluate(`document.getElementById("plane").innerHTML`);
-  for (const [field, value, words] of [["Jm", "-1", "inertia"], ["K", "", "K"], ["backlash", "1e400", "backlash"]]) {
+  for (const [field, value, words] of [["Jm", "-1", "inertia"], ["K", "", "K"], ["Fm", "-0.5", "friction"]]) {
+    const before = await evaluate(`document.getElementById("plane").innerHTML`);
     await evaluate(`(() => { const f = document.getElementById("f_${field}"); f.value = ${JSON.stringify(value)}; f.dispatchEvent(new Event("input")); })()`);
     await frame();
     const message = await evaluate(`document.getElementById("e_${field}").textContent`);
@@ -164,19 +164,22 @@ try {
     await evaluate(`document.getElementById("case").value = "${id}"; document.getElementById("case").dispatchEvent(new Event("change"))`);
     await frame();
     const rate = await evaluate(`(() => {
-      const e = window.explorer, slider = document.getElementById("s_FL"), live = document.getElementById("slice_live");
-      const v0 = Number(slider.value), n = 12, measure = (withSlice) => {
-        live.checked = withSlice;
-        const t0 = performance.now();
-        for (let i = 1; i <= n; i++) { slider.value = v0 * (1 + 0.02 * i) + 0.001 * i; slider.dispatchEvent(new Event("input")); e.update(); }
-        return n / ((performance.now() - t0) / 1000);
-      };
-      const plain = measure(false), withSlice = measure(true);
+      const e = window.explorer, slider = document.getElementById("s_FL"), n = 12, t = { load: 0, portrait: 0, runs: 0, draw: 0 };
+      const v0 = Number(slider.value), t0 = performance.now();
+      for (let i = 1; i <= n; i++) {
+        slider.value = v0 * (1 + 0.02 * i) + 0.001 * i; slider.dispatchEvent(new Event("input")); e.update();
+        t.load += e.timings.load_ms; t.portrait += e.portrait.ms; t.draw += e.timings.draw_ms;
+        t.runs += e.timings.compute_ms - e.timings.load_ms - e.portrait.ms;
+      }
+      const fps = n / ((performance.now() - t0) / 1000);
+      const s0 = performance.now(); slider.dispatchEvent(new Event("change")); const slice = performance.now() - s0;
       slider.value = v0; slider.dispatchEvent(new Event("input")); e.update();
-      return { plain, withSlice, portrait: e.portrait.ms };
+      for (const k in t) t[k] /= n;
+      return { fps, slice, ...t };
     })()`);
-    console.log(`MEASURED case ${id}: slider redraw ${rate.plain.toFixed(1)} frames/s (portrait ${rate.portrait.toFixed(1)} ms), ` +
-      `${rate.withSlice.toFixed(1)} frames/s with the live slice (25 limit cycles)`);
+    console.log(`MEASURED case ${id}: slider redraw ${rate.fps.toFixed(1)} frames/s (per frame: model ${rate.load.toFixed(1)} ms, ` +
+      `portrait ${rate.portrait.toFixed(1)} ms, step response and trajectories ${rate.runs.toFixed(1)} ms, drawing ${rate.draw.toFixed(1)} ms); ` +
+      `live slice on release ${rate.slice.toFixed(0)} ms (25 limit cycles)`);
     await frame();
     const shot = await cdp("Page.captureScreenshot", { format: "png" });
     fs.writeFileSync(path.join(artifacts, `explorer_case_${id}.png`), Buffer.from(shot.data, "base64"));
