@@ -155,7 +155,7 @@
     const add = (cols) => { if (cols) { xs.push(...cols.theta_o); ys.push(...cols.dtheta_o); } };
     add(S.step?.samples); add(S.portrait.orbit);
     const R = S.loaded.parameters.theta_R, b = S.loaded.parameters.backlash;
-    xs.push(R - 1 - b, R + 1 + b); ys.push(-1, 1);
+    xs.push(R - 2 * b, R + 2 * b); ys.push(-b, b);  // at least the backlash around θR
     const x0 = Math.min(...xs), x1 = Math.max(...xs), y0 = Math.min(...ys), y1 = Math.max(...ys);
     const mx = 0.06 * (x1 - x0), my = 0.08 * (y1 - y0);
     return { x0: x0 - mx, x1: x1 + mx, y0: y0 - my, y1: y1 + my };

@@ -72,3 +72,15 @@ def test_item_python_simulate_from_equals_the_cli():
         v.simulate_from((0, 0, 1, 0))
     sampled = v.simulate_from((0.38, 0), t_end=1, dt=0.5)
     assert list(sampled.t) == [0, 0.5, 1.0]
+
+
+def test_item_explorer_command_writes_the_page(tmp_path):
+    page = os.environ.get("BACKLASH_EXPLORER_PAGE", "")
+    if not page:
+        pytest.skip("this build makes no explorer page (no emcc, or a sanitizer build)")
+    out = tmp_path / "site"
+    assert cli("explorer", "--out", str(out)).strip() == f"wrote {out / 'index.html'}"
+    written = (out / "index.html").read_bytes()
+    assert written == open(page, "rb").read() and b"createBacklashCore" in written and len(written) > 100000
+    run = subprocess.run([os.environ.get("BACKLASH_CLI", "build/bin/backlash"), "explorer"], capture_output=True, text=True)
+    assert run.returncode == 2 and "--out" in run.stderr

@@ -2,7 +2,7 @@
 // Chromium, driven over the DevTools protocol with no npm package — Chromium started with
 // --remote-debugging-pipe reads NUL-terminated JSON commands on fd 3 and answers on fd 4.
 //
-//   node run_in_chromium.mjs PAGE BACKLASH_CLI ARTIFACT_DIR
+//   node run_in_chromium.mjs PAGE BACKLASH_CLI ARTIFACT_DIR [built|not-built]
 //
 // Checks: the page loads from disk with no request outside the page; case V's limit-cycle
 // peak-to-peak shown equals `backlash limit-cycle V --json`'s, and the step response's events
@@ -11,19 +11,24 @@
 // flight); a bad value shows the inline error naming the field and keeps the drawing; a
 // screenshot of each thesis case is written to ARTIFACT_DIR.  Prints the measured times (a 60 s
 // trajectory, the redraw rate while a slider moves).  Exit 77 (ctest SKIP_RETURN_CODE) with the
-// reason when there is no Chromium or no page (a build without emcc).
+// reason when there is no Chromium, or when the build makes no page ("not-built": no emcc, or a
+// sanitizer build); a page the build should have made and did not is a failure.
 import { spawn, execFileSync } from "node:child_process";
 import fs from "node:fs";
 import os from "node:os";
 import path from "node:path";
 
-const [page, cli, artifacts] = process.argv.slice(2);
+const [page, cli, artifacts, built = "built"] = process.argv.slice(2);
 const SKIP = 77;
 const chromium = ["chromium", "chromium-browser", "google-chrome"].map((name) => {
   try { return execFileSync("sh", ["-c", `command -v ${name}`]).toString().trim(); } catch { return ""; }
 }).find((p) => p);
 if (!chromium) { console.log("SKIP: no Chromium installed (apt-get install chromium; scripts/install-deps.sh)"); process.exit(SKIP); }
-if (!fs.existsSync(page)) { console.log(`SKIP: no explorer page ${page} (the build had no emcc: apt-get install emscripten)`); process.exit(SKIP); }
+if (built === "not-built") {
+  console.log("SKIP: this build makes no explorer page (no emcc — apt-get install emscripten — or a sanitizer build)");
+  process.exit(SKIP);
+}
+if (!fs.existsSync(page)) { console.log(`FAIL: the explorer page ${page} is missing`); process.exit(1); }
 fs.mkdirSync(artifacts, { recursive: true });
 
 const failures = [];
