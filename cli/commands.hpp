@@ -69,5 +69,6 @@ void register_sweep_command(CLI::App& app);    // cli/sweep_command.cpp
 void register_import_command(CLI::App& app);   // cli/import_command.cpp
 void register_discrepancy_command(CLI::App& app);  // cli/discrepancy_command.cpp
 void register_map_command(CLI::App& app);      // cli/map_command.cpp
+void register_explorer_command(CLI::App& app); // cli/explorer_command.cpp
 
 }  // namespace backlash::cli

@@ -54,7 +54,8 @@ std::string flag_message(const backlash::api::BadInput& error) {
       {"step", "--step"},       {"t_end", "--t-end"},       {"sample_interval", "--dt"}, {"v0", "--v0"},
       {"vary", "--vary"},       {"from", "--from"},         {"to", "--to"},              {"points", "--points"},
       {"threads", "--threads"}, {"tolerance", "--tolerance"}, {"cutoff", "--cutoff"},    {"window", "--window"},
-      {"validation", "--validate"}, {"target", "sweep"},    {"case", "validate"}};
+      {"validation", "--validate"}, {"target", "sweep"},    {"case", "validate"},
+      {"gap", "--gap"},         {"other_velocity", "--other-velocity"}};
   const auto flag = flags.find(error.argument());
   return flag == flags.end() ? error.what() : flag->second + ": " + error.problem();
 }
@@ -97,6 +98,7 @@ int main(int argument_count, char** arguments) {
   backlash::cli::register_import_command(app);
   backlash::cli::register_discrepancy_command(app);
   backlash::cli::register_map_command(app);
+  backlash::cli::register_explorer_command(app);
   refuse_empty_out(app);
   guard_standard_streams();
   backlash::output::clean_up_on_signals();

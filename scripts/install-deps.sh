@@ -15,6 +15,7 @@ required_packages=(
   libhdf5-dev libopenmpi-dev openmpi-bin libboost-mpi-dev
   texlive-latex-base texlive-latex-recommended texlive-fonts-recommended poppler-utils
   python3-sympy python3-scipy python3-numpy python3-pytest python3-dev pybind11-dev
+  emscripten nodejs chromium
 )
 
 missing_packages=()

@@ -144,7 +144,7 @@ Case Case::from_texts(const std::vector<std::pair<std::string, std::string>>& pa
   std::map<std::string, std::string> given;  // facade name → value text
   for (const auto& [name, value] : parameters) {
     const bool known = std::any_of(parameter_keys().begin(), parameter_keys().end(),
-                                   [&](const ParameterKey& k) { return name == k.name; });
+                                   [&name = name](const ParameterKey& k) { return name == k.name; });
     if (!known) throw BadInput(name, "unknown parameter (allowed: " + allowed_names() + ")");
     if (!given.emplace(name, value).second) throw BadInput(name, "given twice");
   }

@@ -6,12 +6,15 @@
 
 #include "backlash/numeric/effects_limit_cycle.hpp"
 #include "backlash/numeric/scales.hpp"
+#include "backlash/numeric/segment_dynamics.hpp"
 
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <utility>
 
 namespace backlash::api {
 
@@ -165,10 +168,12 @@ void check_sample_interval(double sample_interval) {
     throw BadInput("sample_interval", "must be > 0, got " + detail::number_text(sample_interval));
 }
 
-Simulation Model::simulate_csv(const SimulationRequest& request, const TextSink& csv) const {
-  check_sample_interval(request.sample_interval);
-  numeric::SimulationOptions options;
-  Simulation out = prepared(*this, request, options);
+namespace {
+
+/// Runs `out` (its options prepared) with its CSV handed to `csv` as it is computed:
+/// the header, each sample, the early-stop line (simulate_csv, simulate_from_state_csv).
+void stream_csv(Simulation& out, numeric::SimulationOptions& options, const TextSink& csv,
+                const std::function<numeric::SimulationResult(const numeric::SimulationOptions&)>& run) {
   const char* contact_mode = out.effects.compliant() ? "mesh" : "contact";
   csv(csv_header);
   std::string line;
@@ -178,8 +183,140 @@ Simulation Model::simulate_csv(const SimulationRequest& request, const TextSink&
     append_sample(line, s, contact_mode);
     csv(line);
   };
-  out.result = numeric::simulate_effects_step(effect_model(), out.step, options);
+  out.result = run(options);
   if (const std::string end = csv_end(out); !end.empty()) csv(end);
+}
+
+}  // namespace
+
+Simulation Model::simulate_csv(const SimulationRequest& request, const TextSink& csv) const {
+  check_sample_interval(request.sample_interval);
+  numeric::SimulationOptions options;
+  Simulation out = prepared(*this, request, options);
+  stream_csv(out, options, csv, [&](const numeric::SimulationOptions& o) {
+    return numeric::simulate_effects_step(effect_model(), out.step, o);
+  });
+  return out;
+}
+
+// ---------------------------------------------------------------------- a run from any state
+
+StartState start_state(const numeric::Parameters& p, const std::vector<double>& from, bool in_contact,
+                       std::optional<double> gap, std::optional<double> other_velocity) {
+  if (from.size() == 4) {
+    if (gap) throw BadInput("gap", "only with the measured shaft's two values (from = theta_o, dtheta_o)");
+    if (other_velocity) throw BadInput("other_velocity", "only with the measured shaft's two values (from = theta_o, dtheta_o)");
+    return {from[0], from[1], from[2], from[3], in_contact};
+  }
+  if (from.size() != 2)
+    throw BadInput("from", "expected theta_m,dtheta_m,theta_L,dtheta_L or theta_o,dtheta_o, got " +
+                               std::to_string(from.size()) + " values");
+  const double theta_o = from[0], dtheta_o = from[1];
+  // In contact: the face driving toward θR; in flight: the face contact would leave at this state (eq. 25's Tc).
+  const int face = in_contact ? (theta_o <= p.theta_R ? -1 : +1) : (numeric::transmitted_torque_at(p, theta_o, dtheta_o) > 0 ? +1 : -1);
+  const double x = gap.value_or(face * p.backlash / 2);  // θL − θm
+  const double other = other_velocity.value_or(dtheta_o);
+  if (p.measured_at == model::MeasuredAt::Motor) return {theta_o, dtheta_o, theta_o + x, other, in_contact};
+  return {theta_o - x, other, theta_o, dtheta_o, in_contact};
+}
+
+namespace {
+
+/// A free start on a face σ must open the gap: not move into the face, and — both shafts at
+/// one velocity, the nominal model — not be a state where contact on σ holds (−σ·Tc > 0: the
+/// drive presses the shafts together; the flight would end at once).
+void refuse_closing_flight(const numeric::Parameters& p, const numeric::Effects& e, const numeric::HybridState& h) {
+  const double dx = h.dtheta_L - h.dtheta_m;
+  const std::string where = "in free flight on the face x = " + std::string(h.face > 0 ? "+" : "-") + "b/2";
+  if (h.face * dx > 0)
+    throw BadInput("from", where + " the gap would close beyond the face (dtheta_L - dtheta_m = " +
+                               detail::number_text(dx) + "): start in contact");
+  if (dx != 0 || e.any()) return;
+  const double torque = numeric::transmitted_torque_at(p, numeric::measured(p, h), numeric::measured_velocity(p, h));
+  if (-h.face * torque > 0)
+    throw BadInput("from", where + " the drive presses the shafts together (transmitted torque " +
+                               detail::number_text(torque) + " holds contact on this face): start in contact, or "
+                               "in flight from the other face");
+}
+
+/// The start state checked for admissibility (StartState's rules; BadInput "from" naming the
+/// coordinate and the rule), made exact on its face: the measured shaft kept, the other one at
+/// x = ±b/2 from it, so that a typed decimal state lies on the face.
+numeric::HybridState admitted_start(const numeric::Parameters& p, const numeric::Effects& e, const StartState& s) {
+  const std::pair<const char*, double> values[] = {
+      {"theta_m", s.theta_m}, {"dtheta_m", s.dtheta_m}, {"theta_L", s.theta_L}, {"dtheta_L", s.dtheta_L}};
+  for (const auto& [name, v] : values)
+    if (!std::isfinite(v)) throw BadInput("from", std::string(name) + " is not finite, got " + detail::number_text(v));
+  const double half = p.backlash / 2, x = s.theta_L - s.theta_m;
+  const double slack = 1e-12 * std::max({half, std::fabs(s.theta_m), std::fabs(s.theta_L)});  // the rounding of x
+  const bool at_face = std::fabs(std::fabs(x) - half) <= slack;
+  const std::string gap = "the gap theta_L - theta_m = " + detail::number_text(x);
+  const std::string faces = " (the faces are at +-b/2 = +-" + detail::number_text(half) + ")";
+  numeric::HybridState h{s.theta_m, s.dtheta_m, s.theta_L, s.dtheta_L, s.in_contact, x > 0 ? +1 : -1};
+  if (!s.in_contact) {
+    if (p.backlash <= 0) throw BadInput("from", "a rigid drive (backlash 0) has no free flight: start in contact");
+    if (std::fabs(x) > half + slack) throw BadInput("from", gap + " is outside the backlash" + faces);
+    if (!at_face)
+      throw BadInput("from", gap + " is inside the backlash" + faces + ": a free flight starts on the face it leaves "
+                                 "(the simulators' flights run from a face; docs/design.md, \"simulate --from\")");
+    h.face = x > 0 ? +1 : -1;
+    refuse_closing_flight(p, e, h);
+  } else if (e.compliant()) {
+    if (std::fabs(x) < half - slack)
+      throw BadInput("from", gap + " is inside the backlash: the mesh is engaged only at or beyond a face" + faces +
+                                 "; start in free flight instead");
+  } else {
+    if (!at_face) throw BadInput("from", gap + " is not on a face" + faces + ": in contact the gap is +-b/2; start in "
+                                           "free flight for a gap inside");
+    if (std::fabs(s.dtheta_m - s.dtheta_L) > 1e-12 * std::max(std::fabs(s.dtheta_m), std::fabs(s.dtheta_L)))
+      throw BadInput("from", "in contact both shafts move at one velocity: dtheta_m = " + detail::number_text(s.dtheta_m) +
+                                 ", dtheta_L = " + detail::number_text(s.dtheta_L));
+  }
+  if (at_face && !(s.in_contact && e.compliant())) {  // exactly on the face, the measured shaft kept
+    const double theta_o = numeric::measured(p, h);
+    (p.measured_at == model::MeasuredAt::Motor ? h.theta_L : h.theta_m) =
+        theta_o + (p.measured_at == model::MeasuredAt::Motor ? 1 : -1) * h.face * half;
+  }
+  if (s.in_contact && !e.compliant()) h.dtheta_m = h.dtheta_L = numeric::measured_velocity(p, h);
+  h.drive_regime = numeric::drive_regime(p, e, numeric::measured(p, h));
+  return h;
+}
+
+/// A run from a state: its request checked and its options made; the result is still to be computed.
+Simulation prepared_from(const Model& m, const StartState& start, const SimulationRequest& request,
+                         numeric::SimulationOptions& options) {
+  if (request.step) throw BadInput("step", "not with a start state (--from): the run starts from that state");
+  Simulation out;
+  out.t_end = requested_t_end(m.source().spec(), request.t_end);
+  check_sampling(request.sample_interval, out.t_end);
+  out.case_id = m.id();
+  out.parameters = m.evaluator().parameters();
+  out.effects = m.effect_model().effects();
+  out.start = admitted_start(out.parameters, out.effects, start);
+  if (const auto problem = numeric::time_resolution_problem(out.parameters, out.effects, out.t_end))
+    throw BadInput("t_end", *problem);
+  options.t_end = out.t_end;
+  options.sample_interval = request.sample_interval;
+  return out;
+}
+
+}  // namespace
+
+Simulation Model::simulate_from_state(const StartState& start, const SimulationRequest& request) const {
+  numeric::SimulationOptions options;
+  Simulation out = prepared_from(*this, start, request, options);
+  out.result = numeric::simulate_effects(effect_model(), *out.start, options);
+  return out;
+}
+
+Simulation Model::simulate_from_state_csv(const StartState& start, const SimulationRequest& request,
+                                          const TextSink& csv) const {
+  check_sample_interval(request.sample_interval);
+  numeric::SimulationOptions options;
+  Simulation out = prepared_from(*this, start, request, options);
+  stream_csv(out, options, csv, [&](const numeric::SimulationOptions& o) {
+    return numeric::simulate_effects(effect_model(), *out.start, o);
+  });
   return out;
 }
 
@@ -295,6 +432,9 @@ std::string Simulation::json() const {
                        {"in_contact", f.in_contact},
                        {"motor_stuck", f.motor_stuck},
                        {"load_stuck", f.load_stuck}}}};
+  if (start)
+    out["from"] = {{"theta_m", start->theta_m}, {"dtheta_m", start->dtheta_m}, {"theta_L", start->theta_L},
+                   {"dtheta_L", start->dtheta_L}, {"in_contact", start->in_contact}, {"face", start->face}};
   if (stopped_early()) out["stop_reason"] = result.stop_reason;
   return detail::document(out);
 }
@@ -308,8 +448,14 @@ std::string Simulation::csv() const {
 
 std::string Simulation::text() const {
   std::string out;
-  appendf(out, "%s, step %g over %g s: %s, %zu events (effects: %s)\n", case_id.c_str(), step, t_end,
-          numeric::to_string(result.status), result.events.size(), effects.describe().c_str());
+  if (start)
+    appendf(out, "%s, from theta_m = %.10g, dtheta_m = %.10g, theta_L = %.10g, dtheta_L = %.10g (%s) over %g s: %s, %zu "
+                 "events (effects: %s)\n", case_id.c_str(), start->theta_m, start->dtheta_m, start->theta_L, start->dtheta_L,
+            start->in_contact ? "contact" : "free flight", t_end, numeric::to_string(result.status), result.events.size(),
+            effects.describe().c_str());
+  else
+    appendf(out, "%s, step %g over %g s: %s, %zu events (effects: %s)\n", case_id.c_str(), step, t_end,
+            numeric::to_string(result.status), result.events.size(), effects.describe().c_str());
   for (const numeric::SimulationEvent& e : result.events)
     appendf(out, "  t = %14.10f  %-13s theta_o = %12.8f  dtheta_o = %12.8f%s%s%s\n", e.t, numeric::to_string(e.kind),
             e.theta_o, e.dtheta_o, e.bounce ? "  (bounce)" : "", e.accumulation ? "  (end of a bounce series)" : "",

@@ -13,6 +13,9 @@ Conventions: docs/physics.md, effects: docs/effects.md, contracts: docs/design.m
                                                # run.stopped_early, run.stop_reason (no exception);
                                                # dt=0.01: the samples' spacing (> 0, at most 1e7
                                                # samples; dt=None: events only)
+    run = v.simulate_from((0.38, 0))           # from any state, as `simulate --from`: (θm, θ̇m, θL, θ̇L)
+                                               # or (θo, θ̇o) [gap=, other_velocity=]; flight=True:
+                                               # free flight leaving a face (default: contact)
     lines = v.trace([1, 0.5, 0.13])            # dividing lines
     d = v.derive()                             # exact solutions: d.text, d.latex, d.json
     c = backlash.load(name="mine", measured_at="load", Jm="1/2", Fm=0.1, JL=0.5, FL=0.3,

@@ -136,6 +136,22 @@ api::Simulation simulate_sampled(const PyCase& c, api::SimulationRequest request
   }
 }
 
+/// Case.simulate_from: the run from a state (api::start_state: θm, θ̇m, θL, θ̇L or θo, θ̇o), as
+/// `simulate --from`, sampled every `dt` [s] (None: events only).
+api::Simulation simulate_from_sampled(const PyCase& c, const std::vector<double>& from, bool in_contact,
+                                      std::optional<double> gap, std::optional<double> other_velocity,
+                                      std::optional<double> t_end, std::optional<double> dt) {
+  const api::Model& model = c.model();
+  const api::StartState start = api::start_state(model.evaluator().parameters(), from, in_contact, gap, other_velocity);
+  try {
+    if (dt) api::check_sample_interval(*dt);
+    return model.simulate_from_state(start, {.t_end = t_end, .sample_interval = dt.value_or(0)});
+  } catch (const api::BadInput& bad) {
+    if (bad.argument() != "sample_interval") throw;
+    throw api::BadInput("dt", bad.problem());
+  }
+}
+
 py::dict candidate_dict(const discrepancy::Candidate& c) {
   py::dict parameters, uncertainty;
   for (const discrepancy::Parameter& p : c.parameters) {
@@ -176,6 +192,14 @@ void bind_cases(py::module_& m) {
             return simulate_sampled(c, {.step = step, .t_end = t_end}, dt);
           },
           py::arg("step") = py::none(), py::arg("t_end") = py::none(), py::arg("dt") = 0.01, Release())
+      .def(
+          "simulate_from",
+          [](const PyCase& c, const std::vector<double>& from, bool flight, std::optional<double> gap,
+             std::optional<double> other_velocity, std::optional<double> t_end, std::optional<double> dt) {
+            return simulate_from_sampled(c, from, !flight, gap, other_velocity, t_end, dt);
+          },
+          py::arg("from_"), py::arg("flight") = false, py::arg("gap") = py::none(), py::arg("other_velocity") = py::none(),
+          py::arg("t_end") = py::none(), py::arg("dt") = 0.01, Release())
       .def(
           "trace",
           [](const PyCase& c, std::optional<std::vector<double>> v0) {

@@ -176,6 +176,8 @@ struct Simulation {
   /// stop_reason for an early stop, and the trajectory samples when a sample interval was
   /// asked for (none from Model::simulate_csv, which streams them).
   numeric::SimulationResult result;
+  /// The admitted start state of a run from a state (simulate_from_state; its JSON's "from").
+  std::optional<numeric::HybridState> start{};
 
   /// θo − θR at the end [rad].
   double final_error() const { return result.theta_o_final - parameters.theta_R; }
@@ -217,6 +219,29 @@ struct FreeFlightStart {
   double theta_o = 0;   ///< [rad]
   double dtheta_o = 0;  ///< [rad/s]
 };
+
+/// `simulate --from`: any state of the hybrid system as a start (docs/physics.md: the gap
+/// x = θL − θm is centred, the faces are x = ±b/2): both shafts' angles [rad] and velocities
+/// [rad/s], in contact (on the face x = ±b/2, both shafts at one velocity; with a compliant mesh,
+/// the mesh engaged: |x| >= b/2) or in free flight leaving a face (x = ±b/2, the gap not
+/// closing beyond it; the nominal model with both shafts at one velocity: the drive not
+/// pressing them together — a flight that would end at once).  Model::simulate_from_state
+/// checks it and runs the model from it.
+struct StartState {
+  double theta_m = 0, dtheta_m = 0, theta_L = 0, dtheta_L = 0;
+  bool in_contact = true;
+};
+
+/// The start state a front end was given (`simulate --from LIST`, Python's
+/// simulate_from(from_=...)): `from` is θm, θ̇m, θL, θ̇L, or θo, θ̇o — the measured shaft, the
+/// gap x = θL − θm then `gap` (default: on the face that drives toward θR: x = −b/2 when
+/// θo <= θR, the motor pushing forward, else +b/2; in flight: the face contact would leave
+/// there, +b/2 when eq. 25's transmitted torque Tc > 0, else −b/2) and the other shaft moving at
+/// `other_velocity` (default θ̇o).  In contact unless `in_contact` is false (free flight).
+/// BadInput "from" for a list of another length, "gap" / "other_velocity" when given with
+/// the four shaft values.  Admissibility is Model::simulate_from_state's to check.
+StartState start_state(const numeric::Parameters& p, const std::vector<double>& from, bool in_contact,
+                       std::optional<double> gap = std::nullopt, std::optional<double> other_velocity = std::nullopt);
 
 /// `trace`: the dividing lines — for each θ̇m0 on the separation line θo = θR + cot φ·θ̇m0,
 /// the first recombination (or recontact): time [s], motor and load just before the
@@ -287,6 +312,16 @@ class Model {
   /// sampled every `sample_interval` [s] (0: events only).  BadInput "face" (not ±1),
   /// "theta_o" / "dtheta_o" (not finite), "t_end", "sample_interval".
   Simulation simulate_from(const FreeFlightStart& start, double t_end, double sample_interval = 0) const;
+  /// The run from any admissible state (StartState; not a step: Simulation::step is 0, and
+  /// Simulation::start is set) to request.t_end (default: the case's t_end, else 60 s),
+  /// sampled every request.sample_interval.  BadInput "from" for a state that is not
+  /// admissible, naming the coordinate and the rule: a value not finite, a gap outside
+  /// [−b/2, b/2] (a compliant mesh in contact: inside the faces), contact off the faces or with
+  /// two velocities, free flight off a face or closing onto it, free flight of a rigid drive (b = 0); "step" when request.step is set;
+  /// "t_end", "sample_interval" as for simulate().
+  Simulation simulate_from_state(const StartState& start, const SimulationRequest& request = {}) const;
+  /// The same, its CSV handed to `csv` as it is computed (as simulate_csv).
+  Simulation simulate_from_state_csv(const StartState& start, const SimulationRequest& request, const TextSink& csv) const;
   /// One point of the dividing lines at θ̇m0 = `v0` [rad/s], found by the direct search for
   /// the first gap event (numeric::dividing_line_point; trace() samples a profile instead):
   /// how the thesis's printed table entries are checked.
