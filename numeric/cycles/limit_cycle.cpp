@@ -335,7 +335,11 @@ LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycl
   } else {
     GridSurvey survey;
     const std::vector<double> roots = bracketed_roots(evaluator, options, survey);
-    if (roots.empty()) return without_fixed_point(p, options, survey);
+    if (roots.empty()) {
+      LimitCycle none = without_fixed_point(p, options, survey);
+      none.survey_fallback = true;
+      return none;
+    }
     choose_fixed_point(evaluator, roots, cycle);
     cycle.survey_fallback = true;
     // The half cycle at v*, with its exact extremes; the other half is its mirror image about θR.
