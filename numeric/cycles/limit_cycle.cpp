@@ -321,9 +321,11 @@ LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycl
   // Newton's method from the neighbour's cycle (options.guess), else from the describing
   // function's; the logarithmic grid survey only when neither settles on a stable cycle.
   std::optional<NewtonResult> newton;
-  if (!options.survey_only)
-    for (const double guess : {options.guess, describing_function_separation_velocity(p)})
-      if (!newton && guess > 0 && std::isfinite(guess)) newton = newton_fixed_point(evaluator, guess);
+  auto from = [&](double guess) {
+    if (!newton && !options.survey_only && guess > 0 && std::isfinite(guess)) newton = newton_fixed_point(evaluator, guess);
+  };
+  from(options.guess);
+  if (!newton) from(describing_function_separation_velocity(p));
   HalfCycle half;
   if (newton) {
     cycle.status = CycleStatus::LimitCycle;
