@@ -138,7 +138,7 @@ struct NewtonResult {
 };
 
 // Newton's method on h(v) = g(v) − v from `guess`, g' from the closed forms: v* when the steps
-// settle (the last one below 1e-12 v, or at the noise floor of g below 1e-11 v) on a stable
+// settle (the last one below 1e-13 v, or at the noise floor of g below 1e-11 v) on a stable
 // fixed point (|g'| < 1) within [guess/4, 4·guess]; nothing otherwise (the caller surveys).
 std::optional<NewtonResult> newton_fixed_point(const ValidatedEvaluator& evaluator, double guess) {
   double v = guess, previous_step = INFINITY;
@@ -148,7 +148,7 @@ std::optional<NewtonResult> newton_fixed_point(const ValidatedEvaluator& evaluat
     if (!d || !(*d < 1)) return std::nullopt;
     const double step = (h.v_out - v) / (*d - 1);
     const double size = std::fabs(step);
-    if (size <= 1e-12 * v || (size <= 1e-11 * v && size >= 0.5 * previous_step)) {
+    if (size <= 1e-13 * v || (size <= 1e-11 * v && size >= 0.5 * previous_step)) {
       if (!(std::fabs(*d) < 1) || !(h.duration > 0)) return std::nullopt;
       if (!(previous_step <= 1e-5 * v)) h = half_cycle(evaluator, v, true);
       return NewtonResult{v, *d, std::move(h)};

@@ -41,7 +41,7 @@ const numeric::ValidatedEvaluator& thesis_case(const std::string& id) {
 double relative(double a, double b) { return std::fabs(a - b) / std::max(std::fabs(a), std::fabs(b)); }
 
 // The answers of two searches of one point: the same status and, on a cycle, the same numbers
-// within `tolerance` relative (Newton stops when its step is below 1e-12 v*, toms748 when its
+// within `tolerance` relative (Newton stops when its step is below 1e-13 v*, toms748 when its
 // bracket is below 1e-13: both within 1e-12 of v*, and every other figure moves with v*).
 void expect_same_cycle(const numeric::LimitCycle& a, const numeric::LimitCycle& b, double tolerance, const std::string& what) {
   ASSERT_EQ(a.status, b.status) << what;
