@@ -557,6 +557,7 @@ std::string Cycle::json() const {
     out["iterations"] = cycle.iterations;
     out["residual"] = value(cycle.residual);
   } else {
+    out["survey_fallback"] = cycle.survey_fallback;  // Newton from the first guess did not settle
     out["stability_constant"] = {{"C_separation", value(cycle.C_separation)},
                                  {"C_recombination", value(cycle.C_recombination)},
                                  {"contact_arc_crossings_of_theta_R", cycle.contact_arc_crossings_of_theta_R},

@@ -186,6 +186,7 @@ std::string Sweep::summary_line() const {
   detail::appendf(out, "sweep: %ld points on %d threads; parametric family validated at %ld samples (%ld failed), branches:",
                   points, threads, summary.validated_samples, summary.failed_samples);
   for (const std::string& b : summary.covered_branches) out += " " + b;
+  detail::appendf(out, "; %ld limit-cycle searches fell back to the grid survey", summary.survey_fallbacks);
   return out + "\n";
 }
 

@@ -65,7 +65,7 @@ struct Crossing {
 // Rank 0: one pass over points.bin; returns the grid's crossings (consecutive points along an
 // axis, one with a limit cycle, the other "none").
 std::vector<Crossing> read_points(const MapPlan& plan, const fs::path& staging, MapHdf5* h5, Figures& figures,
-                                  bool boundary) {
+                                  bool boundary, long& survey_fallbacks) {
   const std::size_t d = plan.request().vary.size(), size = MapRecord::size(d);
   std::vector<std::int8_t> status;
   if (boundary) status.resize(static_cast<std::size_t>(plan.count()));
@@ -79,6 +79,7 @@ std::vector<Crossing> read_points(const MapPlan& plan, const fs::path& staging, 
       const MapRecord r = read_record(buffer.data() + size * static_cast<std::size_t>(k), d);
       if (h5) h5->add(r);
       figures.add(r, d);
+      survey_fallbacks += r.survey_fallback ? 1 : 0;
       if (boundary) status[static_cast<std::size_t>(at)] = static_cast<std::int8_t>(r.status);
     }
   }
@@ -176,6 +177,7 @@ std::string map_json(const MapPlan& plan, const MapSummary& summary) {
   j["settle"] = {{"step", plan.step()}, {"t_end", plan.t_end()}, {"samples", numeric::SettleOptions{}.samples},
                  {"fraction", numeric::SettleOptions{}.fraction}};
   j["boundary_points"] = summary.boundary_points;
+  j["survey_fallbacks"] = summary.survey_fallbacks;
   return j.dump(2) + "\n";
 }
 
@@ -192,7 +194,7 @@ void finish_map(const MapPlan& plan, const MapOutput& output,
   std::vector<Crossing> crossings;
   if (root) {
     if (output.hdf5) h5.emplace(staging / "map.h5", plan);
-    crossings = read_points(plan, staging, h5 ? &*h5 : nullptr, figures, boundary);
+    crossings = read_points(plan, staging, h5 ? &*h5 : nullptr, figures, boundary, summary.survey_fallbacks);
   }
   std::vector<MapBoundaryRow> rows;
   if (boundary) rows = solve_all(plan, std::move(crossings), output.transport, family, output.interrupted);

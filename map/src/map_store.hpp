@@ -28,10 +28,13 @@ inline std::int8_t map_status_code(const std::string& status) {
     if (names[k] == status && k != map_status_other) return static_cast<std::int8_t>(k);
   return map_status_other;
 }
+/// The bit of a record's status word that says the search fell back to the grid survey.
+inline constexpr std::int64_t map_survey_fallback_bit = 256;
 /// True for the statuses of a point whose limit-cycle search ran (its settle time is computed).
 inline bool map_status_searched(std::int64_t code) { return code <= 2 || code == 7; }
 
-/// A record: index (int64), status code (int64), then doubles: the d varied values, the
+/// A record: index (int64), status code (int64; bit 8: the limit-cycle search fell back to the grid
+/// survey, numeric::LimitCycle::survey_fallback), then doubles: the d varied values, the
 /// parameters of points.csv (numeric::point_column_names: the structure and every effect
 /// parameter), peak_to_peak, amplitude, period, separation_velocity, multiplier, settle_time
 /// (NaN when the row has none).
@@ -40,13 +43,15 @@ struct MapRecord {
   static constexpr std::size_t kParameters = 7 + model::kEffectParameterCount;
   static constexpr std::size_t kValues = kParameters + 6;
   std::int64_t index = 0, status = 0;
+  bool survey_fallback = false;
   std::vector<double> values;
   static std::size_t size(std::size_t d) { return 16 + 8 * (d + kValues); }
 };
 
 inline void append_record(std::string& out, const MapRow& r) {
   const std::int64_t head[2] = {r.index, map_status_code(api::status_of(r.row))};
-  out.append(reinterpret_cast<const char*>(head), sizeof head);
+  const std::int64_t word[2] = {head[0], head[1] | (r.row.cycle.survey_fallback ? map_survey_fallback_bit : 0)};
+  out.append(reinterpret_cast<const char*>(word), sizeof word);
   const numeric::Parameters& p = r.row.point.parameters;
   const numeric::Effects& e = r.row.point.effects;
   const bool cycle = head[1] == 0, computed = map_status_searched(head[1]);
@@ -63,6 +68,8 @@ inline MapRecord read_record(const char* bytes, std::size_t d) {
   MapRecord r;
   std::memcpy(&r.index, bytes, 8);
   std::memcpy(&r.status, bytes + 8, 8);
+  r.survey_fallback = (r.status & map_survey_fallback_bit) != 0;
+  r.status &= ~map_survey_fallback_bit;
   r.values.resize(d + MapRecord::kValues);
   std::memcpy(r.values.data(), bytes + 16, 8 * (d + MapRecord::kValues));
   return r;

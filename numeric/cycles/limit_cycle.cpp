@@ -1,5 +1,6 @@
 #include "backlash/numeric/limit_cycle.hpp"
 
+#include "backlash/numeric/describing_function.hpp"
 #include "backlash/numeric/first_crossing.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
 
@@ -97,25 +98,64 @@ double excess(const ValidatedEvaluator& evaluator, double v) {
 
 bool converged(double a, double b) { return std::fabs(b - a) <= 1e-13 * std::max(1.0, std::fabs(b)); }
 
-// Secant steps from a guess (sweeps: the neighbour's cycle); nothing if they wander off.
-// Also returns h'(v*) from the last secant pair whose spacing is well above the noise
-// of h (|Δv| ≥ 1e-7 v): accurate to about five digits, enough for the multiplier in sweeps.
-struct SecantResult {
-  double v, slope;
+// g'(v) from the closed forms, for the half cycle of one flight and one contact arc (events:
+// a recombination that holds, then the separation).  In error coordinates θ − θR every mode is
+// linear and homogeneous: the flight from the separation line is v·(its flight for v = 1), so
+// ∂x/∂v = (x − θR)/v, and the contact arc maps (θo − θR, θ̇o) linearly (Φ).  The event times
+// move with v (dt = −(∂guard/∂v)/(dguard/dt)), the impact (eq. 24) is linear, and g = −θ̇o at the
+// separation Tc = r·y + r0 = 0 (segment_dynamics.hpp).  Nothing for other half cycles (bounces).
+std::optional<double> closed_form_derivative(const ValidatedEvaluator& evaluator, const HalfCycle& h) {
+  const Parameters& p = evaluator.parameters();
+  if (!h.valid || h.events.size() != 2) return std::nullopt;
+  const SimulationEvent &impact = h.events[0], &separation = h.events[1];
+  if (impact.kind != EventKind::Recombination || impact.bounce || separation.kind != EventKind::Separation)
+    return std::nullopt;
+  const double v = h.v_in, t1 = impact.t, R = p.theta_R;
+  const FreeState f = evaluator.free_state(t1, v);
+  const double em = f.theta_m - R, eL = f.theta_L - R;
+  const double ddm = -(p.Fm * f.dtheta_m + p.K * (p.measured_at == model::MeasuredAt::Load ? eL : em)) / p.Jm;
+  const double ddL = -p.FL * f.dtheta_L / p.JL;
+  const double dt1 = -(f.gap / v) / (f.dtheta_L - f.dtheta_m);  // the gap moves by −σb whatever v
+  const double dm = em / v + f.dtheta_m * dt1, dL = eL / v + f.dtheta_L * dt1;
+  const double dvm = f.dtheta_m / v + ddm * dt1, dvL = f.dtheta_L / v + ddL * dt1;
+  const double w0 = p.measured_at == model::MeasuredAt::Load ? dL : dm, w1 = (p.Jm * dvm + p.JL * dvL) / (p.Jm + p.JL);
+  // The contact arc: y(τ2) moves by Φ(τ2)·w + ẏ·dτ2, with r·y(τ2) + r0 = 0.
+  Parameters centred = p;
+  centred.theta_R = 0;
+  const ContactState phi_w = contact_state(centred, separation.t - t1, w0, w1);
+  const TransmittedTorque tc = transmitted_torque(p);
+  const double ddo = contact_acceleration(p, separation.theta_o, separation.dtheta_o);
+  const double r_ydot = tc.r(0) * separation.dtheta_o + tc.r(1) * ddo;
+  const double dt2 = -(tc.r(0) * phi_w.theta_o + tc.r(1) * phi_w.dtheta_o) / r_ydot;
+  const double derivative = -(phi_w.dtheta_o + ddo * dt2);
+  return std::isfinite(derivative) ? std::optional<double>(derivative) : std::nullopt;
+}
+
+// A fixed point found by Newton's method: v*, g'(v*) and the half cycle there (with extremes).
+struct NewtonResult {
+  double v, derivative;
+  HalfCycle half;
 };
-std::optional<SecantResult> secant_fixed_point(const ValidatedEvaluator& evaluator, double guess) {
-  double v0 = guess, v1 = guess * 1.001;
-  double h0 = excess(evaluator, v0), h1 = excess(evaluator, v1);
-  double slope = std::nan("");
-  for (int i = 0; i < 30; ++i) {
-    if (std::isnan(h0) || std::isnan(h1) || h1 == h0) return std::nullopt;
-    if (std::fabs(v1 - v0) >= 1e-7 * std::fabs(v1)) slope = (h1 - h0) / (v1 - v0);
-    const double v2 = v1 - h1 * (v1 - v0) / (h1 - h0);
-    if (!(v2 > 0) || v2 > 4 * guess || v2 < guess / 4) return std::nullopt;
-    if (converged(v1, v2)) return SecantResult{v2, slope};
-    v0 = v1; h0 = h1;
-    v1 = v2; h1 = excess(evaluator, v1);
-    if (h1 == 0) return SecantResult{v1, slope};
+
+// Newton's method on h(v) = g(v) − v from `guess`, g' from the closed forms: v* when the steps
+// settle (the last one below 1e-13 v, or at the noise floor of g below 1e-11 v) on a stable
+// fixed point (|g'| < 1) within [guess/4, 4·guess]; nothing otherwise (the caller surveys).
+std::optional<NewtonResult> newton_fixed_point(const ValidatedEvaluator& evaluator, double guess) {
+  double v = guess, previous_step = INFINITY;
+  for (int i = 0; i < 16; ++i) {
+    HalfCycle h = half_cycle(evaluator, v, previous_step <= 1e-5 * v);
+    const std::optional<double> d = closed_form_derivative(evaluator, h);
+    if (!d || !(*d < 1)) return std::nullopt;
+    const double step = (h.v_out - v) / (*d - 1);
+    const double size = std::fabs(step);
+    if (size <= 1e-13 * v || (size <= 1e-11 * v && size >= 0.5 * previous_step)) {
+      if (!(std::fabs(*d) < 1) || !(h.duration > 0)) return std::nullopt;
+      if (!(previous_step <= 1e-5 * v)) h = half_cycle(evaluator, v, true);
+      return NewtonResult{v, *d, std::move(h)};
+    }
+    previous_step = size;
+    v -= step;
+    if (!(v > guess / 4 && v < 4 * guess)) return std::nullopt;
   }
   return std::nullopt;
 }
@@ -183,12 +223,12 @@ LimitCycle without_fixed_point(const Parameters& p, const LimitCycleOptions& opt
   return cycle;
 }
 
-// The cycle among the fixed points: the first stable one (|g'| < 1), else the first.  g'(v) by
-// central differences (g is smooth away from grazing), always at the root itself, never from
-// the path that found it (a sweep's secant steps): the multiplier must not depend on where the
-// search started.
+// The cycle among the fixed points: the first stable one (|g'| < 1), else the first.  g'(v) from
+// the closed forms (closed_form_derivative), else by central differences (g is smooth away from
+// grazing), always at the root itself: the multiplier must not depend on where the search started.
 void choose_fixed_point(const ValidatedEvaluator& evaluator, const std::vector<double>& roots, LimitCycle& cycle) {
   auto derivative = [&](double v) {
+    if (const std::optional<double> d = closed_form_derivative(evaluator, half_cycle(evaluator, v))) return *d;
     const double h = 1e-6 * v;
     return (half_cycle(evaluator, v + h).v_out - half_cycle(evaluator, v - h).v_out) / (2 * h);
   };
@@ -278,21 +318,41 @@ LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycl
     cycle.reason = "no backlash: a rigid drive never separates, so there is no cycle";
     return cycle;
   }
-  std::vector<double> roots;
-  if (options.guess > 0)
-    if (auto r = secant_fixed_point(evaluator, options.guess)) roots.push_back(r->v);
-  GridSurvey survey;
-  if (roots.empty()) roots = bracketed_roots(evaluator, options, survey);
-  if (roots.empty()) return without_fixed_point(p, options, survey);
-  choose_fixed_point(evaluator, roots, cycle);
+  // Newton's method from the neighbour's cycle (options.guess), else from the describing
+  // function's; the logarithmic grid survey only when neither settles on a stable cycle.
+  std::optional<NewtonResult> newton;
+  auto from = [&](double guess) {
+    if (!newton && !options.survey_only && guess > 0 && std::isfinite(guess)) newton = newton_fixed_point(evaluator, guess);
+  };
+  from(options.guess);
+  if (!newton) from(describing_function_separation_velocity(p));
+  HalfCycle half;
+  if (newton) {
+    cycle.status = CycleStatus::LimitCycle;
+    cycle.separation_velocity = newton->v;
+    cycle.half_map_derivative = newton->derivative;
+    cycle.multiplier = newton->derivative * newton->derivative;
+    cycle.stable = true;
+    half = std::move(newton->half);
+  } else {
+    GridSurvey survey;
+    const std::vector<double> roots = bracketed_roots(evaluator, options, survey);
+    if (roots.empty()) {
+      LimitCycle none = without_fixed_point(p, options, survey);
+      none.survey_fallback = true;
+      return none;
+    }
+    choose_fixed_point(evaluator, roots, cycle);
+    cycle.survey_fallback = true;
+    // The half cycle at v*, with its exact extremes; the other half is its mirror image about θR.
+    half = half_cycle(evaluator, cycle.separation_velocity, true);
+  }
   const double chosen = cycle.separation_velocity;
-
-  // The half cycle at v*, with its exact extremes; the other half is its mirror image about θR.
-  const HalfCycle half = half_cycle(evaluator, chosen, true);
   if (!half.valid || !(half.duration > 0)) {
     // The root lies where the half cycle does not return (g jumps there, e.g. across a grazing
     // or a same-face separation): no cycle, never one with period 0.  (Found by the soak test.)
     LimitCycle none;
+    none.survey_fallback = cycle.survey_fallback;
     none.reason = "the half-cycle map changes sign at v = " + std::to_string(chosen) +
                   " only across a discontinuity: the half cycle there does not return to the separation line (" +
                   (half.valid ? std::string("it returns at once") : half.outcome) + ")";

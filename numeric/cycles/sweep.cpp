@@ -289,9 +289,13 @@ void run_sweep_streamed(long count, const std::function<SweepPoint(long)>& point
     queue.stop();
     for (std::thread& t : pool) t.join();
   };
+  long survey_fallbacks = 0;
   try {
     while (const std::optional<std::vector<SweepRow>> rows = queue.next())
-      for (const SweepRow& r : *rows) row(r);
+      for (const SweepRow& r : *rows) {
+        survey_fallbacks += r.cycle.survey_fallback ? 1 : 0;
+        row(r);
+      }
   } catch (...) {
     stop_workers();
     throw;
@@ -302,6 +306,7 @@ void run_sweep_streamed(long count, const std::function<SweepPoint(long)>& point
     summary->validated_samples = family.samples_validated();
     summary->failed_samples = family.samples_failed();
     summary->covered_branches = family.covered_branches();
+    summary->survey_fallbacks = survey_fallbacks;
   }
 }
 

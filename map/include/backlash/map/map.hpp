@@ -174,6 +174,7 @@ struct MapSummary {
   long resumed_from = 0;         ///< the first point computed by this run
   long kept = 0;                 ///< interrupted: the points of complete blocks kept for --resume
   long boundary_points = 0;
+  long survey_fallbacks = 0;     ///< points whose limit-cycle search fell back to the grid survey
   bool complete = false;         ///< false: interrupted, the partial folder kept for --resume
   std::string figures_note;      ///< why figures were not drawn (empty: drawn)
 };

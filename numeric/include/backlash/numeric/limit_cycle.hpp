@@ -6,8 +6,11 @@
 //   g(v) = −θ̇o at the next separation,  starting from the separation point
 //          θo = θR + cot φ·v, θ̇o = v > 0 (free flight, impact, contact arc),
 // is computed with the exact hybrid simulator; a limit cycle is a fixed point
-// g(v*) = v*, bracketed on a logarithmic grid and refined with Boost.Math's
-// toms748.  The full return map is P = g∘g, so its multiplier is P'(v*) = g'(v*)²
+// g(v*) = v*, found by Newton's method from a first guess (the neighbour's cycle
+// in sweeps and maps, else the describing function's: describing_function.hpp)
+// with g' from the closed forms, or — when Newton's steps do not settle on a stable
+// cycle — bracketed on a logarithmic grid and refined with Boost.Math's toms748
+// (LimitCycle::survey_fallback; only the survey lists other_fixed_points).  The full return map is P = g∘g, so its multiplier is P'(v*) = g'(v*)²
 // (stable when < 1).  On the cycle: the amplitude max|θo − θR|, the peak-to-peak
 // swings of θo, θm and θL (one frame, docs/physics.md), the period and the
 // separation velocity v*, and eq. 38's C at separation and just after
@@ -78,13 +81,17 @@ struct LimitCycle {
   int iterations = 0;                         ///< full cycles iterated before convergence
   double rest_error = 0;                      ///< "none" because the motion stops: θo − θR at rest
   HybridState section_state;                  ///< the cycle's crossing of the return map's section (warm starts)
+  /// Nominal searches: Newton's method from the first guess did not settle on a stable cycle, so
+  /// the logarithmic grid survey ran (every "none" and "divergent" answer comes from it).
+  bool survey_fallback = false;
 };
 
 struct LimitCycleOptions {
   double v_min = 1e-4, v_max = 10;  ///< search range of separation velocities (× limit_cycle_velocity_unit)
   int grid = 40;                    ///< logarithmic grid points for the bracketing search
-  double guess = 0;                 ///< > 0: start with secant steps from this v (continuation in sweeps),
-                                    ///< falling back to the bracketing search if they do not converge
+  double guess = 0;                 ///< > 0: Newton's first guess (continuation in sweeps and maps), tried
+                                    ///< before the describing function's; the grid survey if neither settles
+  bool survey_only = false;         ///< the grid survey alone, no Newton (checks of the fast path)
 };
 
 LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycleOptions& options = {});

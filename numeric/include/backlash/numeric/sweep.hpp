@@ -81,6 +81,7 @@ struct SweepOptions {
 struct SweepSummary {
   long validated_samples = 0, failed_samples = 0;
   std::vector<std::string> covered_branches;
+  long survey_fallbacks = 0;  ///< rows whose limit-cycle search fell back to the grid survey (LimitCycle::survey_fallback)
 };
 
 std::vector<SweepRow> run_sweep(const std::vector<SweepPoint>& points, const SweepOptions& options,

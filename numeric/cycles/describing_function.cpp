@@ -1,8 +1,10 @@
-#include "backlash/reports/describing_function.hpp"
+#include "backlash/numeric/describing_function.hpp"
+
+#include "backlash/numeric/parametric.hpp"
 
 #include <cmath>
 
-namespace backlash::reports {
+namespace backlash::numeric {
 
 std::complex<double> backlash_describing_function(double A, double b) {
   if (!(A > b / 2)) return {0.0, 0.0};
@@ -29,9 +31,17 @@ double growth_rate(double J, double F, double K, std::complex<double> N) {
   return std::max(r1.real(), r2.real());
 }
 
+// g(β) = Re N − c (Im N)², β = 1 − b/A ∈ (−1, 1), c = JK/F²: zero on a predicted cycle.
+double balance(double beta, double c) {
+  const double root = std::sqrt(std::max(0.0, 1 - beta * beta));
+  const double re = (M_PI / 2 + std::asin(beta) + beta * root) / M_PI;
+  const double im = -(1 - beta * beta) / M_PI;
+  return re - c * im * im;
+}
+
 }  // namespace
 
-DescribingFunctionPrediction describing_function_prediction(const numeric::Parameters& p) {
+DescribingFunctionPrediction describing_function_prediction(const Parameters& p) {
   DescribingFunctionPrediction out;
   if (p.measured_at != model::MeasuredAt::Load) {
     out.reason = "the backlash is outside the loop (output at the motor): the loop is linear, the describing function "
@@ -49,13 +59,7 @@ DescribingFunctionPrediction describing_function_prediction(const numeric::Param
     return out;
   }
   const double c = J * K / (F * F);
-  // g(β) = Re N − c (Im N)², β = 1 − b/A ∈ (−1, 1).
-  const auto g = [&](double beta) {
-    const double root = std::sqrt(std::max(0.0, 1 - beta * beta));
-    const double re = (M_PI / 2 + std::asin(beta) + beta * root) / M_PI;
-    const double im = -(1 - beta * beta) / M_PI;
-    return re - c * im * im;
-  };
+  const auto g = [c](double beta) { return balance(beta, c); };
   // scan with points clustered at both ends, refine by bisection
   const int n = 20000;
   double previous_beta = -1 + 1e-12, previous = g(previous_beta);
@@ -88,4 +92,29 @@ DescribingFunctionPrediction describing_function_prediction(const numeric::Param
   return out;
 }
 
-}  // namespace backlash::reports
+double describing_function_separation_velocity(const Parameters& p) {
+  const double J = p.Jm + p.JL, F = p.Fm + p.FL, K = p.K, b = p.backlash;
+  if (p.measured_at != model::MeasuredAt::Load || !(b > 0) || !(F > 0)) return 0;
+  const double c = J * K / (F * F);
+  // The root of largest amplitude (largest β): the first sign change coming down from β = 1,
+  // where g > 0, on 64 points clustered at both ends, then bisected.
+  const int n = 64;
+  double hi = 1 - 1e-12;
+  for (int k = n - 1; k >= 0; --k) {
+    double lo = -std::cos(M_PI * k / n) * (1 - 1e-12);
+    if (balance(lo, c) < 0) {
+      for (int it = 0; it < 60 && hi - lo > 1e-15; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (balance(mid, c) < 0 ? lo : hi) = mid;
+      }
+      const double A = b / (1 - 0.5 * (lo + hi));
+      const double omega = -K * backlash_describing_function(A, b).imag() / F;
+      const double swing = A - b / 2, slope = omega * cot_phi(p);
+      return omega * swing / std::sqrt(1 + slope * slope);
+    }
+    hi = lo;
+  }
+  return 0;
+}
+
+}  // namespace backlash::numeric
