@@ -376,7 +376,13 @@ Cycle Model::limit_cycle() const {
   out.case_id = case_.id();
   out.parameters = evaluator().parameters();
   out.effects = effect_model().effects();
-  out.cycle = numeric::find_limit_cycle(effect_model(), options);
+  if (out.effects.any()) {
+    out.cycle = numeric::find_limit_cycle(effect_model(), options);
+  } else {  // the single answer lists every further cycle (the survey runs after Newton too)
+    numeric::LimitCycleOptions nominal;
+    nominal.list_other_fixed_points = true;
+    out.cycle = numeric::find_limit_cycle(effect_model().nominal(), nominal);
+  }
   return out;
 }
 

@@ -334,6 +334,11 @@ LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycl
     cycle.multiplier = newton->derivative * newton->derivative;
     cycle.stable = true;
     half = std::move(newton->half);
+    if (options.list_other_fixed_points) {
+      GridSurvey survey;
+      for (double r : bracketed_roots(evaluator, options, survey))
+        if (std::fabs(r - newton->v) > 1e-9 * newton->v) cycle.other_fixed_points.push_back(r);
+    }
   } else {
     GridSurvey survey;
     const std::vector<double> roots = bracketed_roots(evaluator, options, survey);

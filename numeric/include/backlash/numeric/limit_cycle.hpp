@@ -10,7 +10,8 @@
 // in sweeps and maps, else the describing function's: describing_function.hpp)
 // with g' from the closed forms, or — when Newton's steps do not settle on a stable
 // cycle — bracketed on a logarithmic grid and refined with Boost.Math's toms748
-// (LimitCycle::survey_fallback; only the survey lists other_fixed_points).  The full return map is P = g∘g, so its multiplier is P'(v*) = g'(v*)²
+// (LimitCycle::survey_fallback; only the survey lists other_fixed_points, run after Newton too
+// when LimitCycleOptions::list_other_fixed_points asks).  The full return map is P = g∘g, so its multiplier is P'(v*) = g'(v*)²
 // (stable when < 1).  On the cycle: the amplitude max|θo − θR|, the peak-to-peak
 // swings of θo, θm and θL (one frame, docs/physics.md), the period and the
 // separation velocity v*, and eq. 38's C at separation and just after
@@ -92,6 +93,9 @@ struct LimitCycleOptions {
   double guess = 0;                 ///< > 0: Newton's first guess (continuation in sweeps and maps), tried
                                     ///< before the describing function's; the grid survey if neither settles
   bool survey_only = false;         ///< the grid survey alone, no Newton (checks of the fast path)
+  bool list_other_fixed_points = false;  ///< also run the grid survey after Newton has settled, so that
+                                         ///< other_fixed_points lists every further cycle (the facade's
+                                         ///< single answer); off in sweeps and maps, where it stays empty
 };
 
 LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycleOptions& options = {});
