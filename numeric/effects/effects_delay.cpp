@@ -197,7 +197,7 @@ using Vector = std::array<double, 4>;
 class DelayedSegment final : public Segment {
  public:
   DelayedSegment(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start, double t0,
-                 double horizon, double stop_at, DelayLine& line)
+                 double horizon, double stop_at, DelayLine& line, int left_zone)
       : p_(p), e_(e), m_(m), start_(start), t0_(t0), line_(line) {
     sys_ = mode_system(p, e, m, start, true);
     n_ = static_cast<int>(sys_.segment.A.rows());
@@ -205,6 +205,7 @@ class DelayedSegment final : public Segment {
     functionals_.theta_o_error = theta_o_error();
     functionals_.gap = gap();
     functionals_.drive = Functional{SmallRow::Zero(n_), 0, 0, 1};
+    functionals_.left_zone = left_zone;
     witnesses_ = mode_witnesses(p, e, m, functionals_, false);
     const double stop = std::min(t0 + horizon, stop_at);
     const bool stuck = m.kind == ModeKind::Contact ? m.slip_motor == 0 : (m.slip_motor == 0 && m.slip_load == 0);
@@ -556,7 +557,7 @@ class DelayedEngine final : public Engine {
     if (auto b = breakpoints_.upper_bound(t_ + slack); b != breakpoints_.end()) stop = std::min(stop, *b);
     const auto& changes = line_.regime_changes();
     if (auto c = changes.upper_bound(t_ + slack); c != changes.end()) stop = std::min(stop, c->first);
-    return std::make_unique<DelayedSegment>(p_, e_, m, state_, t_, remaining, stop, line_);
+    return std::make_unique<DelayedSegment>(p_, e_, m, state_, t_, remaining, stop, line_, left_zone());
   }
 
  private:

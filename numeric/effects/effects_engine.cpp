@@ -75,7 +75,8 @@ void free_witnesses(const Parameters& p, const Effects& e, const Mode& m, const 
   } else {
     for (int face : {m.face, -m.face}) {
       const Functional delta = f.gap.scaled(face).shifted(-p.backlash / 2);
-      if (delta.constant <= 1e-11 * delta.magnitude) {  // the displacements start at 0: δ(0) = its constant
+      // the displacements start at 0: δ(0) = its constant
+      if (face == f.left_zone || delta.constant <= 1e-11 * delta.magnitude) {
         add(out, Guard::EngageFace, face, delta.scaled(-1));
       } else {
         add(out, Guard::EngageForce, face, mesh_force_functional(p, e, f, face).scaled(-1));
@@ -395,8 +396,10 @@ void Engine::transition(const Exit& exit, const Mode& m) {
       push(exit.witness.face == m.face ? EventKind::Recontact : EventKind::Recombination);
       count_impact();  // engagements count towards the chattering guard like impacts
       break;
-    case Guard::ZoneExit:
-      break;  // the teeth no longer overlap: the engagement guard changes, nothing happens
+    case Guard::ZoneExit:  // the teeth no longer overlap: the engagement guard changes, nothing happens
+      zone_left_face_ = exit.witness.face;
+      zone_left_at_ = t_;
+      break;
   }
 }
 
@@ -417,6 +420,10 @@ bool Engine::rests_in_free_flight(const Mode& m, const Segment& segment, double 
 }
 
 namespace {
+// Mode changes at one instant without an event (a guard handing over to another) before the
+// engine stops: each changes the mode, so a handful suffice; more is a loop.
+constexpr long max_instant_steps = 64;
+
 bool finite(const HybridState& s) {
   return std::isfinite(s.theta_m) && std::isfinite(s.theta_L) && std::isfinite(s.dtheta_m) && std::isfinite(s.dtheta_L);
 }
@@ -471,7 +478,12 @@ SimulationResult Engine::advance() {
     recorder_.record(t0, t0 + segment->exit->tau + 1e-12, at);
     state_ = segment->state(segment->exit->tau);
     t_ = t0 + segment->exit->tau;
+    const std::size_t events = result_.events.size();
     transition(*segment->exit, mode);
+    instant_steps_ = t_ == t0 && result_.events.size() == events ? instant_steps_ + 1 : 0;
+    if (instant_steps_ > max_instant_steps)
+      return stop(SimulationStatus::WorkLimit, "the mode changed " + std::to_string(max_instant_steps) +
+                                                   " times at one instant without an event (docs/effects.md)");
   }
   return finish(SimulationStatus::Completed);
 }

@@ -77,6 +77,10 @@ struct Exit {
 struct ModeFunctionals {
   Functional theta_o_error, gap, drive;  ///< θo − θR, θL − θm, the drive torque D
   int dimension = 4;
+  /// The face whose overlap zone the motion has just left at this instant (a ZoneExit, 0 if
+  /// none): its teeth count as apart, whatever rounding δ(0) keeps, so that the next guard is
+  /// the engagement and not the same ZoneExit again (docs/effects.md).
+  int left_zone = 0;
 };
 std::vector<Witness> mode_witnesses(const Parameters& p, const Effects& e, const Mode& m, const ModeFunctionals& f,
                                     bool with_drive_limits);
@@ -111,6 +115,8 @@ class Engine {
   double motor_static_torque(const HybridState& s) const;
   double load_static_torque(const HybridState& s) const;
   double contact_torque(const Mode& m, const HybridState& s) const;
+  /// ModeFunctionals::left_zone for a segment starting now.
+  int left_zone() const { return t_ == zone_left_at_ ? zone_left_face_ : 0; }
 
   const Parameters& p_;
   const Effects& e_;
@@ -139,6 +145,9 @@ class Engine {
   bool rests_in_free_flight(const Mode& m, const Segment& segment, double remaining);
 
   long separations_ = 0;
+  int zone_left_face_ = 0;  ///< the face of the last ZoneExit, at zone_left_at_
+  double zone_left_at_ = -1;
+  long instant_steps_ = 0;  ///< consecutive segments that ended at once without an event
   bool stop_reached_ = false;  ///< the event of engine_.stop_at_kind / stop_at_face happened
   std::deque<double> impacts_;
 };
