@@ -161,6 +161,7 @@ void Engine::push(EventKind kind, Body body, bool bounce, bool grazing, bool acc
   if (kind == EventKind::Separation) ++separations_;
   if (engine_.stop_at_face != 0 && kind == engine_.stop_at_kind && state_.face == engine_.stop_at_face && t_ > 0)
     stop_reached_ = true;
+  if (engine_.stop_when && engine_.stop_when(result_.events)) stop_reached_ = true;
 }
 
 double Engine::motor_static_torque(const HybridState& s) const {
@@ -452,7 +453,12 @@ SimulationResult Engine::advance() {
     const Mode mode = mode_of(state_);
     const double remaining = o_.t_end - t_;
     const std::unique_ptr<Segment> segment = next_segment(mode, remaining);
-    if (segment->rest) {  // everything stuck, the drive constant: nothing can change any more
+    if (segment->rest) {  // everything stuck, the drive constant (or coasting to rest): nothing can change any more
+      if (segment->rest_after > 0) {
+        recorder_.record(t_, t_ + segment->rest_after, [&segment](double tau) { return segment->state(tau); });
+        state_ = segment->state(segment->rest_after);
+        t_ += segment->rest_after;
+      }
       push(EventKind::Rest);
       const HybridState resting = state_;
       recorder_.record(t_, o_.t_end + 1e-12, [&resting](double) { return resting; });

@@ -94,7 +94,8 @@ class Segment {
   virtual void extremes(double duration, Extremes& x) const = 0;
   std::optional<Exit> exit;  ///< the first exit before the horizon
   double duration = 0;       ///< exit->tau, the horizon, or a breakpoint of the delayed model
-  bool rest = false;         ///< everything stuck and nothing can move any more
+  bool rest = false;         ///< everything stuck (or coasting to rest) and nothing can happen any more
+  double rest_after = 0;     ///< the rest begins this long after the segment's start
 };
 
 class Engine {
