@@ -6,7 +6,7 @@
 //   item 9   delayed loops: the search simulated max_cycles horizons in steps of at most τ,
 //            whatever the crossings did; it now ends where they repeat or grow, and a stuck motor
 //            with a coasting load comes to rest once nothing can happen any more.
-// Each search runs in a child (fork) under an alarm, so that a hang is a failure, not a hang.
+// Each search runs in a child (fork) under a CPU-time limit, so that a hang is a failure, not a hang.
 // The answers are checked against what an independent simulation (Boost.Odeint) shows.
 #include "backlash/model/case_spec.hpp"
 #include "backlash/numeric/effects.hpp"
@@ -20,6 +20,7 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -36,7 +37,7 @@ namespace {
 using namespace backlash;
 
 constexpr double kStep = 0.62;   // case V's experiment
-constexpr unsigned kSeconds = 20;  // the boundaries test's limit per run (check_effects_boundaries.cpp)
+constexpr rlim_t kSeconds = 20;  // CPU seconds per search: the boundaries test's limit per run
 
 const numeric::ValidatedEvaluator& case_v() {
   static const numeric::ValidationResult v = numeric::validate(numeric::case_evaluator(model::load_case("V")));
@@ -58,7 +59,11 @@ Answer search_in_child(const numeric::Effects& effects) {
   const pid_t pid = ::fork();
   if (pid == 0) {
     ::close(ends[0]);
-    ::alarm(kSeconds);
+    // CPU time, not wall time: the answer's cost, whatever else runs on the machine (a wall
+    // alarm of 10× guards against a child that sleeps).
+    const rlimit cpu{kSeconds, kSeconds};
+    ::setrlimit(RLIMIT_CPU, &cpu);
+    ::alarm(10 * kSeconds);
     const numeric::EffectValidationResult model = numeric::validate_effects(case_v(), effects);
     numeric::EffectLimitCycleOptions o;
     o.step = kStep;
