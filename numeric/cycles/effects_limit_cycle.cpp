@@ -469,6 +469,27 @@ void delayed_failure(const SimulationResult& r, const std::vector<Vector>& x, do
                std::to_string(max_period) + " (" + to_string(r.status) + ")";
 }
 
+// The period k with which the section states repeat at crossing n (1 … max_period), 0 if none.
+int delayed_repeat(const std::vector<Vector>& x, std::size_t n, double tolerance) {
+  const double step = (x[n] - x[n - 1]).cwiseAbs().maxCoeff();
+  return n >= 2 && step <= tolerance * scale_of(x[n]) ? 1 : delayed_period(x, n, tolerance);
+}
+
+// The run ends at the first crossing where the states repeat or grow without bound: what the
+// search reads from a longer run ends there too, and the rest would only cost steps of at most τ.
+EffectsEngineOptions delayed_run_options(const EffectLimitCycleOptions& o, double velocity_scale,
+                                         std::vector<Vector>& seen) {
+  EffectsEngineOptions engine{.general_engine = true};
+  engine.stop_when = [&o, velocity_scale, &seen](const std::vector<SimulationEvent>& events) {
+    const SimulationEvent& e = events.back();
+    if (e.kind != EventKind::Recombination || e.after.face != +1) return false;
+    seen.push_back(coordinates_after(e));
+    const std::size_t n = seen.size() - 1;
+    return diverges(seen[n], velocity_scale) || (n >= 1 && delayed_repeat(seen, n, o.tolerance) != 0);
+  };
+  return engine;
+}
+
 DelayedCycle iterate_delayed(const ValidatedEffectModel& model, const HybridState& seed,
                              const EffectLimitCycleOptions& o, double horizon_per_cycle, double velocity_scale) {
   DelayedCycle out;
@@ -477,7 +498,8 @@ DelayedCycle iterate_delayed(const ValidatedEffectModel& model, const HybridStat
   SimulationOptions so;
   so.t_end = horizon_per_cycle * (o.max_cycles + 2);
   so.max_events = 50 * (o.max_cycles + 2);
-  const SimulationResult r = simulate_effects(model, seed, so, {.general_engine = true});
+  std::vector<Vector> seen;
+  const SimulationResult r = simulate_effects(model, seed, so, delayed_run_options(o, velocity_scale, seen));
   if (r.status == SimulationStatus::Rest) {
     out.iteration.outcome = "rest";
     out.iteration.verdict = Verdict::Settles;
@@ -489,8 +511,7 @@ DelayedCycle iterate_delayed(const ValidatedEffectModel& model, const HybridStat
   for (const SimulationEvent& e : r.events)
     if (e.kind == EventKind::Recombination && e.after.face == +1) crossings.push_back(&e), x.push_back(coordinates_after(e));
   for (std::size_t n = 1; n < x.size() && !diverges(x[n], velocity_scale); ++n) {
-    const double step = (x[n] - x[n - 1]).cwiseAbs().maxCoeff();
-    const int k = n >= 2 && step <= o.tolerance * scale_of(x[n]) ? 1 : delayed_period(x, n, o.tolerance);
+    const int k = delayed_repeat(x, n, o.tolerance);
     if (k == 0) continue;
     const auto K = static_cast<std::size_t>(k);
     out.iteration.verdict = Verdict::Converged;

@@ -112,11 +112,13 @@ class ModeFlow {
   bool uses_matrix_exponential() const;
   /// For a flow known as a sum of exponentials (the mesh modes' eigen-decomposition):
   /// sup over [a, b] of |d^k/dτ^k row·z(τ)| ≤ Σ_j |row·V_j q_j| |λ_j|^k max(e^{Re λ_j a}, e^{Re λ_j b}).
-  /// Empty otherwise (the closed forms are not stiff: the generic bound serves).
+  /// For a flow by the matrix exponential: the bound from z'(a) in the plain and the balanced
+  /// norm, the smaller.  Empty otherwise (the closed forms are not stiff: the generic bound serves).
   std::function<double(double, double)> derivative_bound(const SmallRow& row, int order) const;
 
  private:
   struct Generic;
+  std::function<double(double, double)> matrix_exponential_bound(const SmallRow& row, int order) const;
   Parameters p_;
   Effects e_;
   Mode mode_;

@@ -197,14 +197,15 @@ using Vector = std::array<double, 4>;
 class DelayedSegment final : public Segment {
  public:
   DelayedSegment(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start, double t0,
-                 double horizon, double stop_at, DelayLine& line)
-      : p_(p), e_(e), m_(m), start_(start), t0_(t0), line_(line) {
+                 double horizon, double stop_at, DelayLine& line, int left_zone, double rest_velocity)
+      : p_(p), e_(e), m_(m), start_(start), t0_(t0), line_(line), rest_velocity_(rest_velocity) {
     sys_ = mode_system(p, e, m, start, true);
     n_ = static_cast<int>(sys_.segment.A.rows());
     functionals_.dimension = n_;
     functionals_.theta_o_error = theta_o_error();
     functionals_.gap = gap();
     functionals_.drive = Functional{SmallRow::Zero(n_), 0, 0, 1};
+    functionals_.left_zone = left_zone;
     witnesses_ = mode_witnesses(p, e, m, functionals_, false);
     const double stop = std::min(t0 + horizon, stop_at);
     const bool stuck = m.kind == ModeKind::Contact ? m.slip_motor == 0 : (m.slip_motor == 0 && m.slip_load == 0);
@@ -347,6 +348,24 @@ class DelayedSegment final : public Segment {
     return Arming::Waiting;
   }
 
+  // The motor stuck and the load coasting without Coulomb friction (docs/effects.md, "Rest"):
+  // once the coast has lasted a delay, the drive ahead is fed θo between θL(t − τ) and where the
+  // load ends, θL + θ̇L·JL/FL (a viscous coast is monotone).  When the drive over that range
+  // keeps one regime inside the motor's band and the gap stays open on both sides, nothing can
+  // happen any more: at rest once θ̇L is below the rest velocity, as the nominal rule.
+  bool coasts_to_rest(double t, const SmallVector& z) const {
+    if (m_.kind != ModeKind::Free || m_.slip_motor != 0 || m_.slip_load == 0 || e_.coulomb_load > 0 || !(p_.FL > 0))
+      return false;
+    if (t - e_.delay < t0_ || !(std::fabs(z(3)) < rest_velocity_)) return false;
+    const double travel = z(3) * p_.JL / p_.FL, theta_L = start_.theta_L + z(2);
+    const double gap = theta_L - start_.theta_m;
+    if (!(std::max(std::fabs(gap), std::fabs(gap + travel)) < p_.backlash / 2)) return false;
+    if (p_.measured_at == model::MeasuredAt::Motor) return true;  // θo = θm: the drive is constant
+    const double from = start_.theta_L + z_at(t - e_.delay)(2), to = theta_L + travel;
+    if (drive_regime(p_, e_, from) != drive_regime(p_, e_, to)) return false;
+    return std::fabs(drive_torque(p_, e_, from)) < e_.coulomb_motor && std::fabs(drive_torque(p_, e_, to)) < e_.coulomb_motor;
+  }
+
   // Everything stuck: only the delayed drive moves; the history stays at the current θo.
   void hold_still(double stop) {
     const double quiet = line_.last_motion() + e_.delay;
@@ -452,6 +471,11 @@ class DelayedSegment final : public Segment {
       if (!exit && t == end && end < stop) regime_change(end);
       line_.count_step(t, dt_max);
       if (!exit && t < stop && steps_.size() >= max_segment_steps) return t;  // the engine goes on from here
+      if (!exit && t < stop && coasts_to_rest(t, zb)) {
+        rest = true;
+        rest_after = t - t0_;
+        return t;
+      }
     }
     return stop;
   }
@@ -523,6 +547,7 @@ class DelayedSegment final : public Segment {
   HybridState start_;
   double t0_;
   DelayLine& line_;
+  double rest_velocity_;
   ModeSystem sys_;
   int n_ = 4;
   ModeFunctionals functionals_;
@@ -556,7 +581,7 @@ class DelayedEngine final : public Engine {
     if (auto b = breakpoints_.upper_bound(t_ + slack); b != breakpoints_.end()) stop = std::min(stop, *b);
     const auto& changes = line_.regime_changes();
     if (auto c = changes.upper_bound(t_ + slack); c != changes.end()) stop = std::min(stop, c->first);
-    return std::make_unique<DelayedSegment>(p_, e_, m, state_, t_, remaining, stop, line_);
+    return std::make_unique<DelayedSegment>(p_, e_, m, state_, t_, remaining, stop, line_, left_zone(), o_.rest_velocity);
   }
 
  private:

@@ -75,7 +75,8 @@ void free_witnesses(const Parameters& p, const Effects& e, const Mode& m, const 
   } else {
     for (int face : {m.face, -m.face}) {
       const Functional delta = f.gap.scaled(face).shifted(-p.backlash / 2);
-      if (delta.constant <= 1e-11 * delta.magnitude) {  // the displacements start at 0: δ(0) = its constant
+      // the displacements start at 0: δ(0) = its constant
+      if (face == f.left_zone || delta.constant <= 1e-11 * delta.magnitude) {
         add(out, Guard::EngageFace, face, delta.scaled(-1));
       } else {
         add(out, Guard::EngageForce, face, mesh_force_functional(p, e, f, face).scaled(-1));
@@ -160,6 +161,7 @@ void Engine::push(EventKind kind, Body body, bool bounce, bool grazing, bool acc
   if (kind == EventKind::Separation) ++separations_;
   if (engine_.stop_at_face != 0 && kind == engine_.stop_at_kind && state_.face == engine_.stop_at_face && t_ > 0)
     stop_reached_ = true;
+  if (engine_.stop_when && engine_.stop_when(result_.events)) stop_reached_ = true;
 }
 
 double Engine::motor_static_torque(const HybridState& s) const {
@@ -397,8 +399,10 @@ void Engine::transition(const Exit& exit, const Mode& m) {
       push(exit.witness.face == m.face ? EventKind::Recontact : EventKind::Recombination);
       count_impact();  // engagements count towards the chattering guard like impacts
       break;
-    case Guard::ZoneExit:
-      break;  // the teeth no longer overlap: the engagement guard changes, nothing happens
+    case Guard::ZoneExit:  // the teeth no longer overlap: the engagement guard changes, nothing happens
+      zone_left_face_ = exit.witness.face;
+      zone_left_at_ = t_;
+      break;
     case Guard::Handover:
       break;  // never an exit of a segment (effects_stribeck.cpp)
   }
@@ -421,6 +425,10 @@ bool Engine::rests_in_free_flight(const Mode& m, const Segment& segment, double 
 }
 
 namespace {
+// Mode changes at one instant without an event (a guard handing over to another) before the
+// engine stops: each changes the mode, so a handful suffice; more is a loop.
+constexpr long max_instant_steps = 64;
+
 bool finite(const HybridState& s) {
   return std::isfinite(s.theta_m) && std::isfinite(s.theta_L) && std::isfinite(s.dtheta_m) && std::isfinite(s.dtheta_L);
 }
@@ -449,7 +457,12 @@ SimulationResult Engine::advance() {
     const Mode mode = mode_of(state_);
     const double remaining = o_.t_end - t_;
     const std::unique_ptr<Segment> segment = next_segment(mode, remaining);
-    if (segment->rest) {  // everything stuck, the drive constant: nothing can change any more
+    if (segment->rest) {  // everything stuck, the drive constant (or coasting to rest): nothing can change any more
+      if (segment->rest_after > 0) {
+        recorder_.record(t_, t_ + segment->rest_after, [&segment](double tau) { return segment->state(tau); });
+        state_ = segment->state(segment->rest_after);
+        t_ += segment->rest_after;
+      }
       push(EventKind::Rest);
       const HybridState resting = state_;
       recorder_.record(t_, o_.t_end + 1e-12, [&resting](double) { return resting; });
@@ -475,7 +488,12 @@ SimulationResult Engine::advance() {
     recorder_.record(t0, t0 + segment->exit->tau + 1e-12, at);
     state_ = segment->state(segment->exit->tau);
     t_ = t0 + segment->exit->tau;
+    const std::size_t events = result_.events.size();
     transition(*segment->exit, mode);
+    instant_steps_ = t_ == t0 && result_.events.size() == events ? instant_steps_ + 1 : 0;
+    if (instant_steps_ > max_instant_steps)
+      return stop(SimulationStatus::WorkLimit, "the mode changed " + std::to_string(max_instant_steps) +
+                                                   " times at one instant without an event (docs/effects.md)");
   }
   return finish(SimulationStatus::Completed);
 }

@@ -79,6 +79,10 @@ struct Exit {
 struct ModeFunctionals {
   Functional theta_o_error, gap, drive;  ///< θo − θR, θL − θm, the drive torque D
   int dimension = 4;
+  /// The face whose overlap zone the motion has just left at this instant (a ZoneExit, 0 if
+  /// none): its teeth count as apart, whatever rounding δ(0) keeps, so that the next guard is
+  /// the engagement and not the same ZoneExit again (docs/effects.md).
+  int left_zone = 0;
 };
 std::vector<Witness> mode_witnesses(const Parameters& p, const Effects& e, const Mode& m, const ModeFunctionals& f,
                                     bool with_drive_limits);
@@ -92,7 +96,8 @@ class Segment {
   virtual void extremes(double duration, Extremes& x) const = 0;
   std::optional<Exit> exit;  ///< the first exit before the horizon
   double duration = 0;       ///< exit->tau, the horizon, or a breakpoint of the delayed model
-  bool rest = false;         ///< everything stuck and nothing can move any more
+  bool rest = false;         ///< everything stuck (or coasting to rest) and nothing can happen any more
+  double rest_after = 0;     ///< the rest begins this long after the segment's start
 };
 
 class Engine {
@@ -116,6 +121,8 @@ class Engine {
   double motor_static_torque(const HybridState& s) const;
   double load_static_torque(const HybridState& s) const;
   double contact_torque(const Mode& m, const HybridState& s) const;
+  /// ModeFunctionals::left_zone for a segment starting now.
+  int left_zone() const { return t_ == zone_left_at_ ? zone_left_face_ : 0; }
 
   const Parameters& p_;
   const Effects& e_;
@@ -144,15 +151,19 @@ class Engine {
   bool rests_in_free_flight(const Mode& m, const Segment& segment, double remaining);
 
   long separations_ = 0;
+  int zone_left_face_ = 0;  ///< the face of the last ZoneExit, at zone_left_at_
+  double zone_left_at_ = -1;
+  long instant_steps_ = 0;  ///< consecutive segments that ended at once without an event
   bool stop_reached_ = false;  ///< the event of engine_.stop_at_kind / stop_at_face happened
   std::deque<double> impacts_;
 };
 
 /// The closed-form segment of mode `m` from `start` (effects_simulation.cpp) with `extra` guards
-/// besides the mode's own (Handover guards: their exit ends the segment without an exit).
+/// besides the mode's own (Handover guards: their exit ends the segment without an exit);
+/// `left_zone` as ModeFunctionals::left_zone.
 std::unique_ptr<Segment> closed_form_segment(const Parameters& p, const Effects& e, const Mode& m,
                                              const HybridState& start, double horizon, double t_global,
-                                             const std::vector<Witness>& extra);
+                                             int left_zone, const std::vector<Witness>& extra);
 
 /// Stribeck friction (dopri5 with exact event semantics): effects_stribeck.cpp.
 SimulationResult simulate_stribeck(const Parameters& p, const Effects& e, const HybridState& start,

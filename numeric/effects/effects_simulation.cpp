@@ -24,8 +24,9 @@ using detail::Witness;
 Functional of(const ModeFlow::Functional& f) { return {f.row, f.constant, f.magnitude, 0}; }
 
 // The closed-form mode's coordinates as functionals: θo − θR, the gap, and the drive folded in.
-detail::ModeFunctionals functionals_of(const Parameters& p, const Effects& e, const ModeFlow& flow) {
+detail::ModeFunctionals functionals_of(const Parameters& p, const Effects& e, const ModeFlow& flow, int left_zone) {
   detail::ModeFunctionals f;
+  f.left_zone = left_zone;
   f.theta_o_error = of(flow.theta_o_error());
   f.gap = of(flow.gap_functional());
   f.dimension = static_cast<int>(flow.segment().A.rows());
@@ -164,7 +165,7 @@ class ExitSearch {
 class ClosedFormSegment final : public detail::Segment {
  public:
   ClosedFormSegment(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start, double horizon,
-                    double t_global, const std::vector<Witness>& extra = {})
+                    double t_global, int left_zone, const std::vector<Witness>& extra = {})
       : params_(p), flow_(p, e, m, start) {
     duration = horizon;
     if (m.kind == ModeKind::Contact ? m.slip_motor == 0 : (m.slip_motor == 0 && m.slip_load == 0)) {
@@ -174,7 +175,7 @@ class ClosedFormSegment final : public detail::Segment {
     // Every witness searched window by window, the windows doubling from an eighth of the servo
     // period: the search stops at the first window that holds an exit, never far beyond it.
     std::vector<ExitSearch> searches;
-    std::vector<Witness> witnesses = detail::mode_witnesses(p, e, m, functionals_of(p, e, flow_), true);
+    std::vector<Witness> witnesses = detail::mode_witnesses(p, e, m, functionals_of(p, e, flow_, left_zone), true);
     witnesses.insert(witnesses.end(), extra.begin(), extra.end());
     for (const Witness& w : witnesses) {
       searches.emplace_back(p, flow_, w, horizon, t_global);
@@ -239,7 +240,7 @@ class ClosedFormEngine final : public detail::Engine {
     return drive_torque_in_regime(p_, e_, measured(p_, state_), state_.drive_regime);
   }
   std::unique_ptr<detail::Segment> next_segment(const Mode& mode, double remaining) override {
-    return std::make_unique<ClosedFormSegment>(p_, e_, mode, state_, remaining, t_);
+    return std::make_unique<ClosedFormSegment>(p_, e_, mode, state_, remaining, t_, left_zone());
   }
 };
 
@@ -247,8 +248,9 @@ class ClosedFormEngine final : public detail::Engine {
 
 std::unique_ptr<detail::Segment> detail::closed_form_segment(const Parameters& p, const Effects& e, const Mode& m,
                                                              const HybridState& start, double horizon,
-                                                             double t_global, const std::vector<Witness>& extra) {
-  return std::make_unique<ClosedFormSegment>(p, e, m, start, horizon, t_global, extra);
+                                                             double t_global, int left_zone,
+                                                             const std::vector<Witness>& extra) {
+  return std::make_unique<ClosedFormSegment>(p, e, m, start, horizon, t_global, left_zone, extra);
 }
 
 SimulationResult simulate_effects(const ValidatedEffectModel& model, const HybridState& start,

@@ -75,14 +75,17 @@ double root_in(const std::function<double(double)>& f, double a, double b) {
 class StribeckSegment final : public Segment {
  public:
   StribeckSegment(const Parameters& p, const Effects& level, const Effects& e, const Mode& m, const HybridState& start,
-                  double horizon, double t_global, Budget& budget, const std::vector<Witness>& handovers)
+                  double horizon, double t_global, Budget& budget, const std::vector<Witness>& handovers,
+                  int left_zone)
       : p_(p), e_(e), flow_(p, level, m, start), n_(static_cast<int>(flow_.segment().A.rows())) {
     duration = horizon;
     if (m.kind == ModeKind::Contact ? m.slip_motor == 0 : (m.slip_motor == 0 && m.slip_load == 0)) {
       rest = true;  // everything stuck and no delay: the drive cannot change
       return;
     }
-    witnesses_ = mode_witnesses(p, level, m, functionals(level), true);
+    ModeFunctionals f = functionals(level);
+    f.left_zone = left_zone;
+    witnesses_ = mode_witnesses(p, level, m, f, true);
     witnesses_.insert(witnesses_.end(), handovers.begin(), handovers.end());
     integrate(horizon, t_global, budget);
     if (exit) duration = exit->tau;
@@ -392,14 +395,15 @@ class StribeckEngine final : public Engine {
         ceilings.push_back(handover(mode, c, kEnter, -1));
     }
     if (ceilings.empty()) {  // no drop left to integrate (none slipping: the closed form throughout)
-      auto closed = closed_form_segment(p_, kinetic_level(mode), mode, state_, remaining, t_, floors);
+      auto closed = closed_form_segment(p_, kinetic_level(mode), mode, state_, remaining, t_, left_zone(), floors);
       if (closed->exit || closed->rest || closed->duration > 0) return closed;
     }
-    auto integrated = std::make_unique<StribeckSegment>(p_, e_, stribeck_, mode, state_, remaining, t_, budget_, ceilings);
+    auto integrated = std::make_unique<StribeckSegment>(p_, e_, stribeck_, mode, state_, remaining, t_, budget_, ceilings,
+                                                         left_zone());
     if (integrated->exit || integrated->rest || integrated->duration > 0 || ceilings.empty()) return integrated;
     // A handover at once (rounding at a tiny vs): integrate without it, never an empty segment again.
     return std::make_unique<StribeckSegment>(p_, e_, stribeck_, mode, state_, remaining, t_, budget_,
-                                             std::vector<Witness>{});
+                                             std::vector<Witness>{}, left_zone());
   }
   double friction_drop(bool motor, double velocity) const override { return stribeck_drop(stribeck_, motor, velocity); }
 

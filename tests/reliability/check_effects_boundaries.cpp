@@ -216,16 +216,11 @@ struct BoundaryCase {
   std::vector<std::string> keys;
 };
 
-/// The cases this test found that are not fixed yet: each runs past kSecondsPerRun (the limit-cycle
-/// search of a very soft mesh, issue 18 item 10; the delayed model's limit-cycle search with a
-/// delay far below the servo's time scale, whose cost grows as t_end/τ, item 9).  They are not
-/// run, and every run prints them, so that they are seen until fixed; nothing else is excused.
+/// The cases this test found that are not fixed yet (none now: the very soft mesh of issue 18
+/// item 10 and the delayed limit-cycle searches of item 9 answer, check_effects_engine_items.cpp).
+/// A case listed here is not run, and every run prints it, so that it is seen until fixed.
 std::optional<std::string> open_defect(const std::string& label) {
-  static const std::vector<std::pair<std::string, std::string>> open{
-      {"stiffness = 1e-100 (smallest)", "issue 18 item 10: the limit-cycle search of a very soft mesh"},
-      {"coulomb_motor = 0.186, delay = 0.006283185307179587", "issue 18 item 9: a delayed limit-cycle search, cost ∝ t_end/τ"},
-      {"stiffness = 1, delay = 0.006283185307179587", "issue 18 item 9: a delayed limit-cycle search, cost ∝ t_end/τ"},
-      {"stiffness = 1e+05, delay = 0.6283185307179586", "issue 18 item 9: a delayed limit-cycle search with a stiff mesh"}};
+  static const std::vector<std::pair<std::string, std::string>> open{};
   for (const auto& [known, why] : open)
     if (label == known) return why;
   return std::nullopt;

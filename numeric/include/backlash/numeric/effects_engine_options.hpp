@@ -6,6 +6,9 @@
 
 #include "backlash/numeric/hybrid_simulation.hpp"
 
+#include <functional>
+#include <vector>
+
 namespace backlash::numeric {
 
 /// The options only the effects engine reads, beside the SimulationOptions every simulator reads.
@@ -20,6 +23,9 @@ struct EffectsEngineOptions {
   /// The delayed model's work budget: integration steps per run (each no longer than the delay),
   /// then the status work_limit, exit 3 (docs/effects.md, "Delay").
   long max_delay_steps = 20'000'000;
+  /// Asked after every event with the events so far: true ends the run there, completed (the
+  /// delayed loop's limit-cycle search stops once its crossings repeat).
+  std::function<bool(const std::vector<SimulationEvent>&)> stop_when = {};
 };
 
 /// The accumulation threshold of docs/effects.md: a bounce series whose remaining duration is
