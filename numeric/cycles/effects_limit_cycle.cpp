@@ -1,6 +1,7 @@
 // Limit cycles of the model with effects (effects_limit_cycle.hpp).
 #include "backlash/numeric/effects_limit_cycle.hpp"
 
+#include "backlash/numeric/scales.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
 
 #include <Eigen/Dense>
@@ -25,7 +26,10 @@ using Vector = Eigen::VectorXd;
 // from a crossing is exact (the flags — contact, face, sticking, drive regime — come along).
 class Section {
  public:
-  Section(const ValidatedEffectModel& model, double horizon) : model_(model), horizon_(horizon) {}
+  /// `silent`: the outcome of a return not seen within the horizon (verdict_of: settling only when
+  /// it is the plain "no recombination within the horizon").
+  Section(const ValidatedEffectModel& model, double horizon, std::string silent = "no recombination within the horizon")
+      : model_(model), horizon_(horizon), silent_(std::move(silent)) {}
 
   Vector coordinates(const HybridState& s) const {
     Vector x(4);
@@ -95,8 +99,7 @@ class Section {
     for (const SimulationEvent& e : r.events)
       if (e.kind == EventKind::Recombination && e.after.face == +1 && e.t > 0) crossing = &e;
     if (r.status != SimulationStatus::Completed || crossing == nullptr || r.t_final >= horizon_) {
-      out.outcome = r.status == SimulationStatus::Completed ? "no recombination within the horizon"
-                                                            : std::string(to_string(r.status));
+      out.outcome = r.status == SimulationStatus::Completed ? silent_ : std::string(to_string(r.status));
       return out;
     }
     out.valid = true;
@@ -117,6 +120,7 @@ class Section {
  private:
   const ValidatedEffectModel& model_;
   double horizon_;
+  std::string silent_;
 };
 
 double scale_of(const Vector& x) { return std::max(1.0, x.cwiseAbs().maxCoeff()); }
@@ -638,6 +642,16 @@ void without_cycle(const ValidatedEffectModel& model, const std::vector<Iteratio
   cycle.reason = reason.str();
 }
 
+// The slowest time scale of a compliant mesh (0 for a rigid one): the period 2π√(Jr/kc) of the two
+// bodies swinging against the mesh (Jr = Jm·JL/(Jm + JL)), or its slow relaxation cc/kc when that is
+// longer.  A return to the section can take this long, so the search's horizon covers it (a very
+// soft mesh swings for thousands of seconds; the rigid model's scales would call that settling).
+double slow_mesh_scale(const Parameters& p, const Effects& e) {
+  if (!e.compliant()) return 0;
+  const double Jr = p.Jm * p.JL / (p.Jm + p.JL);
+  return std::max(2 * M_PI * std::sqrt(Jr / e.mesh_stiffness), e.mesh_damping / e.mesh_stiffness);
+}
+
 }  // namespace
 
 LimitCycle find_limit_cycle(const ValidatedEffectModel& model, const EffectLimitCycleOptions& options) {
@@ -649,8 +663,18 @@ LimitCycle find_limit_cycle(const ValidatedEffectModel& model, const EffectLimit
     cycle.reason = "no backlash";
     return cycle;
   }
-  const double horizon = options.horizon > 0 ? options.horizon : 60 * slowest_time_scale(p);  // as limit_cycle.cpp
-  const Section section(model, horizon);
+  // 60 slowest time scales, the mesh's included (as limit_cycle.cpp); when double precision cannot
+  // time that far, the rigid model's, and a return not seen within them is unresolved, not settling.
+  double horizon = options.horizon > 0 ? options.horizon : 60 * std::max(slowest_time_scale(p), slow_mesh_scale(p, e));
+  std::string silent = "no recombination within the horizon";
+  if (options.horizon <= 0 && time_resolution_problem(p, e, horizon)) {
+    horizon = 60 * slowest_time_scale(p);
+    char why[200];
+    std::snprintf(why, sizeof why, " of %.6g s, where the mesh's own slowest time scale is %.6g s (beyond what "
+                  "double precision times)", horizon, slow_mesh_scale(p, e));
+    silent += why;
+  }
+  const Section section(model, horizon, silent);
   const double velocity_scale = std::max(1.0, std::fabs(p.theta_R)) * std::sqrt(p.K / (p.Jm + p.JL));
   std::vector<Iteration> ends;
   for (const HybridState& seed : seeds(model, options)) {

@@ -8,6 +8,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -100,7 +101,8 @@ class Sampler {
   // e^{μ⁺h}.  The intervals of a search have few distinct lengths (t_end − t_begin halved k
   // times), so the last values are kept: the same h gives the same bits, one exp per length.
   double growth(double h) const {
-    const std::uint64_t bits = std::bit_cast<std::uint64_t>(h);
+    std::uint64_t bits;  // std::bit_cast, which the WebAssembly build's libc++ 14 lacks
+    std::memcpy(&bits, &h, sizeof bits);
     GrowthEntry& entry = growth_cache_[(bits ^ (bits >> 29)) % growth_cache_.size()];
     if (!(entry.h == h)) entry = {h, std::exp(std::max(0.0, m_.mu_A) * h)};
     return entry.E;
