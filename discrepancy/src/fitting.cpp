@@ -78,12 +78,14 @@ std::optional<std::vector<std::vector<double>>> Simulator::traces(const ModelPoi
 
 long Simulator::cost(const ModelPoint& m, std::size_t events) const {
   if (!(m.e.delay > 0)) return 1000 + static_cast<long>(events);
-  // A delayed model is integrated numerically: its steps follow its fastest oscillation (the
-  // servo's, or a compliant mesh's) over the record.  400 units per radian: measured, a delayed
-  // case V (ω ≈ 1/s) over 30 s costs about 12 closed-form simulations.
-  double rate = 2 * M_PI / numeric::servo_period(m.p);
-  if (m.e.compliant()) rate = std::max(rate, std::sqrt(m.e.mesh_stiffness * (m.p.Jm + m.p.JL) / (m.p.Jm * m.p.JL)));
-  return 1000 + static_cast<long>(events) + static_cast<long>(400 * (t_end_ - step_time_) * rate);
+  // A delayed model is integrated numerically: its steps follow the servo's oscillation and a
+  // compliant mesh's over the record.  Measured: a delayed case V (ω ≈ 1/s) over 30 s costs about
+  // 12 closed-form simulations (400 per radian of the servo), with a mesh of ω ≈ 26/s about 28
+  // (40 per radian of the mesh).
+  const double span = t_end_ - step_time_;
+  double work = 1000 + static_cast<double>(events) + 400 * span * 2 * M_PI / numeric::servo_period(m.p);
+  if (m.e.compliant()) work += 40 * span * std::sqrt(m.e.mesh_stiffness * (m.p.Jm + m.p.JL) / (m.p.Jm * m.p.JL));
+  return static_cast<long>(work);
 }
 
 std::vector<double> residuals(const Observations& data, const std::vector<std::vector<double>>& traces,
@@ -129,7 +131,7 @@ struct Objective {
     return candidate.apply(base, values);
   }
   std::optional<std::vector<double>> residuals_at(const double* u) const {
-    if (work.load() >= budget || weighted.load() >= 4 * budget || simulator.budget_reached()) return std::nullopt;
+    if (work.load() >= budget || weighted.load() / 4 >= budget || simulator.budget_reached()) return std::nullopt;
     ++calls;
     std::vector<numeric::SimulationEvent> events;
     const ModelPoint m = point(u);
@@ -326,7 +328,7 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
     if (stage + 1 == horizons.size() && whole_record) best.covariance = solve(objective, best.u, true, 0).covariance;
   }
   fit.simulations = calls.load();
-  fit.budget_exhausted = work.load() >= budget || weighted.load() >= 4 * budget || simulator.budget_reached();
+  fit.budget_exhausted = work.load() >= budget || weighted.load() / 4 >= budget || simulator.budget_reached();
   fit.ok = true;
   fit.u = best.u;
   fit.sse_fit = best.sse;

@@ -82,8 +82,8 @@ class Simulator {
   /// Validates the family at these model points (a candidate's range corners).
   void prepare(const std::vector<ModelPoint>& points);
   int simulations() const { return simulations_.load(); }
-  /// A simulation's work: 1000 plus its events; a delayed model's more (numerical integration,
-  /// 400 per radian of its fastest oscillation over the record).
+  /// A simulation's work: 1000 plus its events; a delayed model's more (numerical integration:
+  /// 400 per radian of the servo's oscillation over the record, 40 per radian of a mesh's).
   long cost(const ModelPoint& m, std::size_t events) const;
   /// The work of every simulation so far (cost()).
   long work() const { return work_.load(); }

@@ -118,7 +118,9 @@ void run_trial(Trial& t, Search& s, const std::string& name, double departure, c
   t.result.effect = name;
   try {
     if (t.candidate.ranges.empty()) t.candidate = candidate_for(name, s.current, s.step);
-    t.fit = fit_candidate(s.simulator, s.o, s.current, t.candidate, false, start, s.options.candidate_work, departure);
+    // A pair (started from its singles' fits) gets a quarter of a single candidate's budget.
+    const long budget = start ? s.options.candidate_work / 4 : s.options.candidate_work;
+    t.fit = fit_candidate(s.simulator, s.o, s.current, t.candidate, false, start, budget, departure);
     if (t.fit.budget_exhausted)
       t.result.failure = s.simulator.budget_reached()
                              ? "the search's work budget of " + std::to_string(s.options.total_work) + " was reached"
@@ -212,12 +214,12 @@ std::string combination_problem(const std::string& a, const std::string& b) {
   return "";
 }
 
-// Every pair of the round's best five, fitted together
+// Every pair of the round's best four, fitted together
 // from their single fits and judged with both parameters' penalty.  The best decisive pair, or nothing.
 std::optional<Trial> best_pair(Search& s, const std::vector<Trial>& singles, double departure, std::vector<Candidate>& round) {
   std::vector<const Trial*> top;
   for (const Trial& t : singles)
-    if (t.fit.ok && top.size() < 5) top.push_back(&t);
+    if (t.fit.ok && top.size() < 4) top.push_back(&t);
   std::optional<Trial> best;
   for (std::size_t i = 0; i < top.size(); ++i)
     for (std::size_t j = i + 1; j < top.size(); ++j) {
@@ -329,23 +331,39 @@ void name_pair(Search& s, const Trial& pair, const std::vector<Trial>& singles) 
 void fit_free_parameters(Search& s, const std::vector<std::string>& free) {
   if (free.empty()) return;
   std::vector<Named> named;
+  std::vector<EffectCandidate> parts;
   for (const std::string& key : free) {
     Named n;
     n.candidate = candidate_for(key, s.base, s.step);  // a parameter at 0 is refused here
     n.result.effect = key;
-    n.result.parameters = {{n.candidate.ranges[0].name, nominal_value(key, s.base.p), NAN}};
     named.push_back(n);
+    parts.push_back(n.candidate);
   }
-  const auto point = joint_refit(s, named);
-  if (!point) return;
-  const auto traces = s.simulator.traces(*point, s.o.size());
+  // One or two: the scan and the growing horizons, as for a candidate; more: from the nominal values.
+  const EffectCandidate joint = combined(parts);
+  std::vector<double> start;
+  for (const Named& n : named) {
+    const ParameterRange& r = n.candidate.ranges[0];
+    const double v = nominal_value(n.result.effect, s.base.p);
+    start.push_back(r.logarithmic ? std::log(v / r.low) / std::log(r.high / r.low) : (v - r.low) / (r.high - r.low));
+  }
+  const auto traces0 = s.simulator.traces(s.base, s.o.size());
+  const double departure = traces0 ? first_departure(s.o, (*traces0)[0]) : NAN;
+  const Fit fit = fit_candidate(s.simulator, s.o, s.base, joint, true, free.size() <= 2 ? nullptr : &start,
+                                std::numeric_limits<long>::max(), departure);
+  if (!fit.ok) return;
+  const ModelPoint point = joint.apply(s.base, fit.values);
+  const auto traces = s.simulator.traces(point, s.o.size());
   if (!traces) return;
   const Scores fitted = score(s.o, *traces);
   const double delta = fitted.bic(static_cast<int>(free.size())) - s.scores.bic(0);
   if (!(delta < -s.options.decisive_bic)) return;
-  for (Named& n : named) n.result.delta_bic = delta, n.result.decisive = true;
+  for (std::size_t i = 0; i < named.size(); ++i) {
+    named[i].result.parameters = {{named[i].candidate.ranges[0].name, fit.values[i], fit.uncertainty[i]}};
+    named[i].result.delta_bic = delta, named[i].result.decisive = true;
+  }
   s.named = std::move(named);
-  s.current = *point;
+  s.current = point;
   s.scores = fitted;
 }
 

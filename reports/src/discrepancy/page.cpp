@@ -202,6 +202,25 @@ std::string alternatives_section(const DiscrepancyResult& r) {
   return md.str();
 }
 
+// Every round's candidates.
+std::string rounds_section(const DiscrepancyResult& r) {
+  std::ostringstream md;
+  md << "\n## Candidates\n\nEach effect added to the model and fitted on the first part of the record; scored by its BIC there "
+        "and its RMS on the held-out rest. Decisive: ΔBIC < −10 and the held-out RMS reduced enough.\n\n";
+  for (std::size_t k = 0; k < r.rounds.size(); ++k) {
+    md << "### Round " << k + 1 << "\n\n| effect | parameters | RMS | RMS held out (weighted) | ΔBIC | decisive | simulations |\n"
+       << "|---|---|---|---|---|---|---|\n";
+    for (const Candidate& c : r.rounds[k]) {
+      md << "| " << c.effect << " | ";
+      for (const Parameter& p : c.parameters) md << p.name << " = " << number(p.value) << " ";
+      md << "| " << number(c.rms) << " | " << number(c.rms_holdout) << " | " << number(c.delta_bic) << " | "
+         << (c.decisive ? "yes" : "no") << " | " << c.simulations << " |\n";
+    }
+    md << "\n";
+  }
+  return md.str();
+}
+
 }  // namespace
 
 std::vector<std::pair<std::string, std::string>> report_files(const model::CaseSpec& model, const std::string& data_name,
@@ -272,19 +291,7 @@ std::vector<std::pair<std::string, std::string>> report_files(const model::CaseS
   feature("decay rate [1/s]", &Features::decay_rate);
   feature("cycle amplitude [rad]", &Features::cycle_amplitude);
   feature("cycle period [s]", &Features::cycle_period);
-  md << "\n## Candidates\n\nEach effect added to the model and fitted on the first part of the record; scored by its BIC there "
-        "and its RMS on the held-out rest. Decisive: ΔBIC < −10 and the held-out RMS reduced enough.\n\n";
-  for (std::size_t k = 0; k < r.rounds.size(); ++k) {
-    md << "### Round " << k + 1 << "\n\n| effect | parameters | RMS | RMS held out (weighted) | ΔBIC | decisive | simulations |\n"
-       << "|---|---|---|---|---|---|---|\n";
-    for (const Candidate& c : r.rounds[k]) {
-      md << "| " << c.effect << " | ";
-      for (const Parameter& p : c.parameters) md << p.name << " = " << number(p.value) << " ";
-      md << "| " << number(c.rms) << " | " << number(c.rms_holdout) << " | " << number(c.delta_bic) << " | "
-         << (c.decisive ? "yes" : "no") << " | " << c.simulations << " |\n";
-    }
-    md << "\n";
-  }
+  md << rounds_section(r);
   md << (not_drawn ? *not_drawn : std::string("![candidates](candidates.svg)")) << "\n";
   files.push_back({"discrepancy.md", md.str()});
   return files;
