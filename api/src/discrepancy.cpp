@@ -148,6 +148,16 @@ std::string Discrepancy::text(const std::string& data, const std::string& valida
   appendf(out, "%s against %s: %s (noise %.3g, %d simulations, %.2f s)\n", model_.id.c_str(), data.c_str(),
           discrepancy::to_string(r.status), r.noise, r.simulations, r.seconds);
   append_effects(out, r.effects);
+  for (const discrepancy::ParameterCorrection& c : r.parameter_corrections)
+    appendf(out, "  %-14s  %.6g -> %.6g ± %.2g  (x%.4g)%s\n", c.key.c_str(), c.nominal, c.fitted, c.uncertainty, c.ratio,
+            c.given_free ? "  [fit] free" : "");
+  if (!r.alternatives.empty())
+    appendf(out, "  ambiguous: %s or %s; to tell them apart: %s\n", r.alternatives[0].effect.c_str(),
+            r.alternatives[1].effect.c_str(), r.distinguishing_experiment.c_str());
+  if (r.noise_estimate.correlation > 0 || !r.outliers.empty())
+    appendf(out, "  noise: correlated over tau_int %.3g samples (n_eff %.4g); %zu outliers given no weight\n",
+            r.noise_estimate.tau_int, r.noise_estimate.n_eff, r.outliers.size());
+  if (!r.reason.empty()) appendf(out, "  %s\n", r.reason.c_str());
   if (r.status == discrepancy::Status::Unexplained && !r.rounds.empty() && !r.rounds.front().empty())
     appendf(out, "  best candidate (not decisive): %s, RMS %.3g\n", r.rounds.front().front().effect.c_str(),
             r.rounds.front().front().rms);

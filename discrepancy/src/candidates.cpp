@@ -1,7 +1,8 @@
 // The effects the workflow can name, as things a fit can vary (docs/discrepancy.md):
 // each effect's parameters and the range searched, scaled to the model — torques
 // to the initial drive K·|step|, times to the servo period, the backlash to its
-// nominal value.
+// nominal value — and the nominal parameters a record may correct, each a one-parameter
+// candidate searched from half to twice its nominal value (the reference ±¼ of the step).
 #include "internal.hpp"
 
 #include "backlash/model/effect_table.hpp"
@@ -90,21 +91,78 @@ const std::vector<std::string>& names() {
   return all;
 }
 
-EffectCandidate candidate_for(const std::string& effect, const ModelPoint& base, double step) {
-  const numeric::Parameters& p = base.p;
-  if (const model::EffectInfo* row = model::effect_keyed(effect)) return table_candidate(*row, p, step);
-  if (effect != "backlash_size") throw std::invalid_argument("unknown effect '" + effect + "'");
+namespace {
+
+/// The field of the nominal parameters a parameter candidate corrects ("backlash_size": the backlash).
+double numeric::Parameters::*parameter_field(const std::string& key) {
+  if (key == "motor.J") return &numeric::Parameters::Jm;
+  if (key == "motor.F") return &numeric::Parameters::Fm;
+  if (key == "load.J") return &numeric::Parameters::JL;
+  if (key == "load.F") return &numeric::Parameters::FL;
+  if (key == "K") return &numeric::Parameters::K;
+  if (key == "reference") return &numeric::Parameters::theta_R;
+  if (key == "backlash_size" || key == "backlash") return &numeric::Parameters::backlash;
+  return nullptr;
+}
+
+/// A nominal parameter as a candidate: from half to twice its value (geometric), the reference
+/// within a quarter of the step of its value, the backlash from 0.05 to 4 times its value.
+EffectCandidate parameter_candidate(const std::string& key, const numeric::Parameters& p, double step) {
+  double numeric::Parameters::*field = parameter_field(key);
   EffectCandidate c;
-  c.effect = effect;
-  const double b0 = p.backlash;
-  c.ranges = {b0 > 0 ? ParameterRange{"backlash", 0.05 * b0, 4.0 * b0, true}
-                     : ParameterRange{"backlash", 1e-3 * std::fabs(step), 0.5 * std::fabs(step), true}};
-  c.apply = [](const ModelPoint& b, const std::vector<double>& v) {
+  c.effect = key;
+  const double nominal = p.*field;
+  const std::string name = key == "backlash_size" ? "backlash" : key;
+  if (key == "reference") {
+    c.ranges = {ParameterRange{name, nominal - 0.25 * std::fabs(step), nominal + 0.25 * std::fabs(step), false}};
+  } else if (key == "backlash_size") {
+    c.ranges = {nominal > 0 ? ParameterRange{name, 0.05 * nominal, 4.0 * nominal, true}
+                            : ParameterRange{name, 1e-3 * std::fabs(step), 0.5 * std::fabs(step), true}};
+  } else {
+    if (!(nominal > 0))
+      throw std::invalid_argument(key + " is 0 in the model: a correction is searched as a ratio of its nominal value");
+    c.ranges = {ParameterRange{name, 0.5 * nominal, 2.0 * nominal, true}};
+  }
+  c.apply = [field](const ModelPoint& b, const std::vector<double>& v) {
     ModelPoint m = b;
-    m.p.backlash = v[0];
+    m.p.*field = v[0];
     return m;
   };
   return c;
+}
+
+}  // namespace
+
+EffectCandidate combined(const std::vector<EffectCandidate>& parts) {
+  EffectCandidate joint;
+  std::vector<std::size_t> sizes;
+  for (const EffectCandidate& c : parts) {
+    joint.effect += (joint.effect.empty() ? "" : " + ") + c.effect;
+    joint.ranges.insert(joint.ranges.end(), c.ranges.begin(), c.ranges.end());
+    sizes.push_back(c.ranges.size());
+  }
+  joint.apply = [parts, sizes](const ModelPoint& base, const std::vector<double>& values) {
+    ModelPoint m = base;
+    std::size_t at = 0;
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      m = parts[i].apply(m, std::vector<double>(values.begin() + at, values.begin() + at + sizes[i]));
+      at += sizes[i];
+    }
+    return m;
+  };
+  return joint;
+}
+
+double nominal_value(const std::string& key, const numeric::Parameters& p) {
+  double numeric::Parameters::*field = parameter_field(key);
+  return field ? p.*field : NAN;
+}
+
+EffectCandidate candidate_for(const std::string& effect, const ModelPoint& base, double step) {
+  const numeric::Parameters& p = base.p;
+  if (const model::EffectInfo* row = model::effect_keyed(effect)) return table_candidate(*row, p, step);
+  if (parameter_field(effect) == nullptr || effect == "backlash") throw std::invalid_argument("unknown candidate '" + effect + "'");
+  return parameter_candidate(effect, p, step);
 }
 
 }  // namespace backlash::discrepancy::detail
@@ -112,5 +170,15 @@ EffectCandidate candidate_for(const std::string& effect, const ModelPoint& base,
 namespace backlash::discrepancy {
 
 const std::vector<std::string>& vocabulary() { return detail::names(); }
+
+const std::vector<std::string>& parameter_candidates() {
+  static const std::vector<std::string> keys{"motor.J", "motor.F", "load.J", "load.F", "K", "reference"};
+  return keys;
+}
+
+bool is_parameter_correction(const std::string& candidate) {
+  return candidate == "backlash_size" ||
+         std::find(parameter_candidates().begin(), parameter_candidates().end(), candidate) != parameter_candidates().end();
+}
 
 }  // namespace backlash::discrepancy

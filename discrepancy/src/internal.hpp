@@ -41,8 +41,16 @@ struct EffectCandidate {
   std::vector<std::vector<double>> scan() const;
 };
 
-/// The candidate for `effect` around the model `base` (ranges scaled to the model and experiment).
+/// The candidate for `effect` — an effect of the vocabulary or a nominal parameter
+/// (parameter_candidates(), backlash_size) — around the model `base` (ranges scaled to the model
+/// and experiment).  Throws std::invalid_argument for an unknown name or a parameter that is 0.
 EffectCandidate candidate_for(const std::string& effect, const ModelPoint& base, double step);
+
+/// The value of a nominal parameter (a key of parameter_candidates(), "backlash" or backlash_size).
+double nominal_value(const std::string& key, const numeric::Parameters& p);
+
+/// Several candidates as one: their parameters side by side, applied in turn.
+EffectCandidate combined(const std::vector<EffectCandidate>& parts);
 
 /// The measured columns stacked with their weights (1/σ per column).
 struct Observations {
@@ -50,6 +58,10 @@ struct Observations {
   std::vector<std::vector<double>> columns;       ///< theta_out, then theta_motor / theta_load if present
   std::vector<int> which;                         ///< 0 theta_out, 1 theta_motor, 2 theta_load
   std::vector<double> sigma;                      ///< per column
+  double tau_int = 1;  ///< the noise's integrated autocorrelation time [samples]: the BIC's n_eff = n/τ_int
+  std::vector<char> skip;       ///< samples given no weight (spikes); left out of the index lists
+  std::vector<double> quantum;  ///< per column: an encoder's step (0: none)
+  double floor = 0;             ///< the smallest σ (a noise-free record still has a scale)
   /// The samples fitted, and those held out of every fit: the record cut in ten blocks, the
   /// third, sixth and ninth held out — they cover the transient and the end alike.
   std::vector<std::size_t> fit_indices, holdout_indices, all_indices;
@@ -70,12 +82,22 @@ class Simulator {
   /// Validates the family at these model points (a candidate's range corners).
   void prepare(const std::vector<ModelPoint>& points);
   int simulations() const { return simulations_.load(); }
+  /// A simulation's work: 1000 plus its events; a delayed model's more (numerical integration:
+  /// 400 per radian of the servo's oscillation over the record, 40 per radian of a mesh's).
+  long cost(const ModelPoint& m, std::size_t events) const;
+  /// The work of every simulation so far (cost()).
+  long work() const { return work_.load(); }
+  /// Past this much work the fits stop (their best points kept): the whole search's budget.
+  void set_budget(long budget) { budget_ = budget; }
+  bool budget_reached() const { return work_.load() >= budget_; }
 
  private:
   const Observations& data_;
   double step_, t_end_, step_time_;
   numeric::ValidatedModelFamily family_;
   std::atomic<int> simulations_{0};
+  std::atomic<long> work_{0};
+  long budget_ = std::numeric_limits<long>::max();
 };
 
 /// Weighted residuals of a model against the observations at these samples.
@@ -104,5 +126,100 @@ struct Fit {
 Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoint& base, const EffectCandidate& c,
                   bool whole_record, const std::vector<double>* start_u = nullptr, long budget = std::numeric_limits<long>::max(),
                   double departure = NAN);
+
+}  // namespace backlash::discrepancy::detail
+
+namespace backlash::discrepancy::detail {
+
+/// The noise of one residual column (docs/discrepancy.md, "Noise").
+struct NoiseFit {
+  double sigma = 0;        ///< its level
+  double white_sigma = 0;  ///< MAD(Δ⁴r)/(0.6745·√70): the white-noise rule
+  double a = 0;            ///< AR(1) coefficient per sample (0: white)
+  double tau_int = 1;      ///< (1 + a)/(1 − a)
+};
+
+/// The level and correlation of the noise in a residual r (the record minus a model): the median
+/// of |Δ⁴r| at lags 1, 2, 4, …, 32 samples — while it grows no faster than correlated noise lets it
+/// (×2.5 per doubling of the lag; a smooth gap grows ×256) — fitted by an AR(1) process's
+/// E[(Δ⁴_L e)²] = σ²·(70 − 112ρ + 56ρ² − 16ρ³ + 2ρ⁴), ρ = a^L.  White (a = 0, the lag-1 rule) when
+/// the fit finds a < 0.3 or fewer than three lags are usable.  `quantum`: an encoder's step, the
+/// floor of σ at quantum/√12.  Samples flagged in `skip` (spikes) are left out.
+NoiseFit noise_of_residual(const std::vector<double>& r, const std::vector<char>& skip, double quantum, double floor);
+
+/// An encoder's resolution read off a record: the smallest nonzero difference between samples
+/// when ≥ 98 % of them are whole multiples of it (0: not quantised).
+double quantum_of(const std::vector<double>& y);
+
+/// Isolated spikes of a residual: samples that the linear extrapolations from either side and
+/// the interpolation between their neighbours all miss by more than 6·√6 white σ (a kink — an
+/// impact — is met by one of the three; a spike by none).  Flags them in `skip`.
+void flag_spikes(const std::vector<double>& r, double white_sigma, std::vector<char>& skip);
+
+}  // namespace backlash::discrepancy::detail
+
+namespace backlash::discrepancy::detail {
+
+/// The scores of one model against the observations (weighted residuals).
+struct Scores {
+  double sse_fit = 0, sse_holdout = 0, sse = 0;
+  std::size_t n_fit = 0, n_holdout = 0, n = 0;
+  double tau_int = 1;        ///< the noise's: the BIC counts n_eff = n_fit/τ_int residuals
+  double rms_theta_out = 0;  ///< unweighted, whole record
+  double rms_fit() const { return std::sqrt(sse_fit / std::max<std::size_t>(1, n_fit)); }
+  double rms_holdout() const { return std::sqrt(sse_holdout / std::max<std::size_t>(1, n_holdout)); }
+  double rms() const { return std::sqrt(sse / std::max<std::size_t>(1, n)); }
+  /// n_eff·ln(SSE/n) + k·ln n_eff on the fitted samples.
+  double bic(int parameters) const {
+    const double n_eff = std::max(1.0, static_cast<double>(n_fit) / tau_int);
+    return n_eff * std::log(std::max(sse_fit, 1e-300) / std::max<std::size_t>(1, n_fit)) + parameters * std::log(n_eff);
+  }
+};
+Scores score(const Observations& o, const std::vector<std::vector<double>>& traces);
+
+/// The RMS (in σ) at or below which a model meets the record: the option's level, or three
+/// standard deviations of a correlated noise's sample RMS, 1 + 3·√(τ_int/(2n)), if more.
+double at_noise_level(const Observations& o, double noise_level);
+
+/// A named candidate: its result and what the fit varies.
+struct Named {
+  Candidate result;
+  EffectCandidate candidate;
+};
+
+/// The state of the search for what the model is missing (search.cpp).
+struct Search {
+  Simulator& simulator;
+  Observations& o;
+  const ModelPoint& base;  ///< the nominal model
+  double step;
+  const DiscrepancyOptions& options;
+  ModelPoint current;
+  Scores scores;
+  std::vector<Named> named;
+  std::vector<std::vector<Candidate>> rounds;
+  std::vector<Candidate> alike;  ///< explanations that fit alike, the one adopted first
+  std::string experiment;        ///< the one that would tell them apart
+  int parameters() const;        ///< the fitted parameters of everything named
+  /// Simulates `current` and updates `scores` (false: it could not be simulated).
+  bool rescore();
+};
+
+/// Fits the [fit] free parameters (keys as parameter_candidates(), backlash_size) first, on the
+/// whole record; named when decisive (ΔBIC < −decisive_bic against the nominal model).
+void fit_free_parameters(Search& s, const std::vector<std::string>& free);
+
+/// Rounds of candidates (`remaining`: effects and parameters), pairs where no single one is
+/// decisive, a joint refit and the replacement of a named candidate the others make needless,
+/// until the model meets the record, nothing is decisive, max_effects are named or the budget ends.
+void run_search(Search& s, std::vector<std::string> remaining);
+
+/// The noise of every column re-estimated from the residual of `traces` (σ per column and the
+/// correlation of theta_out's); returns theta_out's.
+NoiseFit reestimate_noise(Observations& o, const std::vector<std::vector<double>>& traces);
+
+/// The first time theta_out's residual leaves the noise band (|r| > 3σ on five consecutive
+/// samples), NaN if never.
+double first_departure(const Observations& o, const std::vector<double>& model);
 
 }  // namespace backlash::discrepancy::detail

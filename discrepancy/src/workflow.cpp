@@ -18,6 +18,9 @@ const char* to_string(Status status) {
     case Status::EffectFound: return "effect_found";
     case Status::NoDiscrepancy: return "no_discrepancy";
     case Status::Unexplained: return "unexplained";
+    case Status::ParametersCorrected: return "parameters_corrected";
+    case Status::PartlyExplained: return "partly_explained";
+    case Status::Ambiguous: return "ambiguous";
   }
   return "?";
 }
@@ -81,197 +84,39 @@ using detail::ModelPoint;
 using detail::Observations;
 using detail::Simulator;
 
-Observations observations_of(const measurements::MeasuredRecord& data, double holdout_fraction, double step) {
+// The measured columns (their σ the white-noise rule on the record, until the residual's noise
+// replaces it), an encoder's quantum per column.
+Observations observations_of(const measurements::MeasuredRecord& data, double step) {
   Observations o;
   o.t = data.t;
+  o.floor = 1e-7 * std::max(std::fabs(step), 1.0);  // a noise-free record still has a scale
   auto add = [&](const std::vector<double>& column, int which) {
-    const double floor = 1e-7 * std::max(std::fabs(step), 1.0);  // a noise-free record still has a scale
     o.columns.push_back(column);
     o.which.push_back(which);
-    o.sigma.push_back(std::max(estimate_noise(column), floor));
+    o.quantum.push_back(detail::quantum_of(column));
+    o.sigma.push_back(std::max({estimate_noise(column), o.floor, o.quantum.back() / std::sqrt(12.0)}));
   };
   add(data.theta_out, 0);
   if (data.theta_motor) add(*data.theta_motor, 1);
   if (data.theta_load) add(*data.theta_load, 2);
-  // Ten blocks; with the default 0.3 held out, the third, sixth and ninth (every k-th block,
-  // k = round(1/fraction)), so the held-out samples see the transient and the end alike.
-  const std::size_t n = data.size();
+  o.skip.assign(data.size(), 0);
+  return o;
+}
+
+// The samples fitted and held out: ten blocks; with the default 0.3 held out, the third, sixth
+// and ninth (every k-th block, k = round(1/fraction)), so the held-out samples see the transient
+// and the end alike.  Samples flagged as spikes are in neither.
+void split_blocks(Observations& o, double holdout_fraction) {
+  const std::size_t n = o.size();
+  o.fit_indices.clear(), o.holdout_indices.clear(), o.all_indices.clear();
   const int every = holdout_fraction > 0 ? std::max(2, static_cast<int>(std::lround(1 / holdout_fraction))) : 0;
   for (std::size_t i = 0; i < n; ++i) {
+    if (o.skip[i]) continue;
     const int block = static_cast<int>(10 * i / n);
     (every > 0 && block % every == every - 1 ? o.holdout_indices : o.fit_indices).push_back(i);
     o.all_indices.push_back(i);
   }
   if (o.holdout_indices.empty()) o.holdout_indices = o.fit_indices;
-  return o;
-}
-
-// The scores of one model against the observations (weighted residuals).
-struct Scores {
-  double sse_fit = 0, sse_holdout = 0, sse = 0;
-  std::size_t n_fit = 0, n_holdout = 0, n = 0;
-  double rms_theta_out = 0;  ///< unweighted, whole record
-  double rms_fit() const { return std::sqrt(sse_fit / std::max<std::size_t>(1, n_fit)); }
-  double rms_holdout() const { return std::sqrt(sse_holdout / std::max<std::size_t>(1, n_holdout)); }
-  double rms() const { return std::sqrt(sse / std::max<std::size_t>(1, n)); }
-  double bic(int parameters) const {
-    return n_fit * std::log(std::max(sse_fit, 1e-300) / n_fit) + parameters * std::log(static_cast<double>(n_fit));
-  }
-};
-
-Scores score(const Observations& o, const std::vector<std::vector<double>>& traces) {
-  Scores s;
-  const std::vector<double> fit = detail::residuals(o, traces, o.fit_indices);
-  const std::vector<double> held = detail::residuals(o, traces, o.holdout_indices);
-  s.sse_fit = detail::sum_of_squares(fit);
-  s.sse_holdout = detail::sum_of_squares(held);
-  s.sse = s.sse_fit + s.sse_holdout;
-  s.n_fit = fit.size();
-  s.n_holdout = held.size();
-  s.n = s.n_fit + s.n_holdout;
-  double sum = 0;
-  for (std::size_t i = 0; i < o.size(); ++i) sum += (o.columns[0][i] - traces[0][i]) * (o.columns[0][i] - traces[0][i]);
-  s.rms_theta_out = std::sqrt(sum / o.size());
-  return s;
-}
-
-// A named effect's parameters as reported (the compliance's damping from its ratio).
-std::vector<Parameter> reported(const EffectCandidate& c, const detail::Fit& fit, const ModelPoint& point) {
-  std::vector<Parameter> out;
-  for (std::size_t i = 0; i < c.ranges.size(); ++i)
-    out.push_back({c.ranges[i].name, fit.values[i], fit.uncertainty.empty() ? NAN : fit.uncertainty[i]});
-  if (c.effect == "compliance") {
-    const double ratio = fit.values[1], ratio_sigma = out[1].uncertainty;
-    const double scale = point.e.mesh_damping / ratio;
-    out[1] = {"damping", point.e.mesh_damping, ratio_sigma * scale};
-  }
-  return out;
-}
-
-double first_departure(const Observations& o, const std::vector<double>& model);
-
-struct Trial {
-  EffectCandidate candidate;
-  detail::Fit fit;
-  Candidate result;
-  ModelPoint point;
-};
-
-// Every candidate of a round, fitted on the first part and scored (threads over candidates).
-std::vector<Trial> round_of(Simulator& simulator, const Observations& o, const ModelPoint& current, int current_k,
-                            const Scores& current_scores, double departure, const std::vector<std::string>& effects,
-                            double step, const DiscrepancyOptions& options) {
-  std::vector<Trial> trials(effects.size());
-  std::atomic<std::size_t> next{0};
-  std::mutex progress_mutex;
-  long finished = 0;
-  auto report = [&] {
-    if (!options.progress) return;
-    std::lock_guard<std::mutex> lock(progress_mutex);
-    options.progress(++finished, static_cast<long>(trials.size()));
-  };
-  auto work = [&] {
-    for (std::size_t i = next++; i < trials.size(); i = next++) {
-      const auto started = std::chrono::steady_clock::now();
-      Trial& t = trials[i];
-      t.candidate = detail::candidate_for(effects[i], current, step);
-      t.result.effect = effects[i];
-      try {
-        t.fit = detail::fit_candidate(simulator, o, current, t.candidate, false, nullptr, options.candidate_work, departure);
-        if (t.fit.budget_exhausted)
-          t.result.failure = "its fit reached the work budget of " + std::to_string(options.candidate_work) + " (1000 per simulation plus its events)";
-      } catch (const std::exception& error) {  // a candidate that cannot be simulated is a failed candidate
-        t.fit = detail::Fit{};
-        t.result.failure = error.what();
-      }
-      t.result.simulations = t.fit.simulations;
-      if (t.fit.ok) {
-        t.point = t.candidate.apply(current, t.fit.values);
-        const auto traces = simulator.traces(t.point, o.size());
-        if (traces) {
-          const Scores s = score(o, *traces);
-          ++t.result.simulations;
-          t.result.parameters = reported(t.candidate, t.fit, t.point);
-          t.result.rms = s.rms_theta_out;
-          t.result.rms_fit = s.rms_fit();
-          t.result.rms_holdout = s.rms_holdout();
-          const int k = current_k + static_cast<int>(t.candidate.ranges.size());
-          t.result.bic = s.bic(k);
-          t.result.delta_bic = t.result.bic - current_scores.bic(current_k);
-          // Decisive on both: the BIC, and the held-out samples — they must shrink, or, when the
-          // model already meets them at the noise level, at least not get worse.
-          const double held = current_scores.rms_holdout();
-          const bool confirmed = t.result.rms_holdout < options.decisive_holdout * held ||
-                                 (held <= options.noise_level && t.result.rms_holdout <= 1.02 * held);
-          // A parameter pinned at the edge of its range says the effect, as parameterised, cannot be
-          // told from its limit (a mesh at the stiffest end is a rigid gear): not decisive.
-          const bool at_edge = std::any_of(t.fit.u.begin(), t.fit.u.end(), [](double u) { return u < 1e-3 || u > 1 - 1e-3; });
-          t.result.at_range_edge = at_edge;
-          t.result.decisive = t.result.delta_bic < -options.decisive_bic && confirmed && !at_edge;
-        } else {
-          t.fit.ok = false;
-        }
-      }
-      if (!t.fit.ok) t.result.bic = t.result.rms = t.result.rms_holdout = INFINITY;
-      t.result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-      report();
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int k = 1; k < std::max(1, options.threads); ++k) pool.emplace_back(work);
-  work();
-  for (std::thread& th : pool) th.join();
-  std::stable_sort(trials.begin(), trials.end(), [](const Trial& a, const Trial& b) { return a.result.bic < b.result.bic; });
-  return trials;
-}
-
-// All named effects refitted together on the whole record, from their current values.
-ModelPoint joint_refit(Simulator& simulator, const Observations& o, const ModelPoint& nominal,
-                       std::vector<Candidate>& named, std::vector<EffectCandidate>& candidates, double step) {
-  EffectCandidate joint;
-  joint.effect = "joint";
-  std::vector<double> start;
-  std::vector<std::size_t> sizes;
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    for (std::size_t j = 0; j < candidates[i].ranges.size(); ++j) {
-      const detail::ParameterRange& r = candidates[i].ranges[j];
-      joint.ranges.push_back(r);
-      double value = named[i].parameters[j].value;
-      if (candidates[i].effect == "compliance" && j == 1)  // the fit's coordinate is the damping ratio
-        value = value / (2 * std::sqrt(named[i].parameters[0].value * nominal.p.Jm * nominal.p.JL / (nominal.p.Jm + nominal.p.JL)));
-      const double u = r.logarithmic ? std::log(value / r.low) / std::log(r.high / r.low) : (value - r.low) / (r.high - r.low);
-      start.push_back(std::min(1.0, std::max(0.0, u)));
-    }
-    sizes.push_back(candidates[i].ranges.size());
-  }
-  joint.apply = [&candidates, sizes](const ModelPoint& base, const std::vector<double>& values) {
-    ModelPoint m = base;
-    std::size_t at = 0;
-    for (std::size_t i = 0; i < candidates.size(); ++i) {
-      m = candidates[i].apply(m, std::vector<double>(values.begin() + at, values.begin() + at + sizes[i]));
-      at += sizes[i];
-    }
-    return m;
-  };
-  const detail::Fit fit = detail::fit_candidate(simulator, o, nominal, joint, true, &start);
-  if (!fit.ok) return joint.apply(nominal, [&] {
-    std::vector<double> v;
-    for (const Candidate& c : named)
-      for (const Parameter& p : c.parameters) v.push_back(p.value);
-    return v;
-  }());
-  const ModelPoint point = joint.apply(nominal, fit.values);
-  std::size_t at = 0;
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    detail::Fit part;
-    part.values.assign(fit.values.begin() + at, fit.values.begin() + at + sizes[i]);
-    part.uncertainty.assign(fit.uncertainty.begin() + at, fit.uncertainty.begin() + at + sizes[i]);
-    named[i].parameters = reported(candidates[i], part, point);
-    named[i].simulations += fit.simulations;
-    at += sizes[i];
-  }
-  (void)step;
-  return point;
 }
 
 std::vector<Region> regions_of(const std::vector<numeric::SimulationEvent>& events, const Observations& o,
@@ -307,15 +152,6 @@ std::vector<Region> regions_of(const std::vector<numeric::SimulationEvent>& even
   return out;
 }
 
-double first_departure(const Observations& o, const std::vector<double>& model) {
-  int run = 0;
-  for (std::size_t i = 0; i < o.size(); ++i) {
-    run = std::fabs(o.columns[0][i] - model[i]) > 3 * o.sigma[0] ? run + 1 : 0;
-    if (run == 5) return o.t[i - 4];
-  }
-  return NAN;
-}
-
 /// The shortest decimal that reads back as `value` (for messages).
 std::string shortest_text(double value) {
   char buffer[32];
@@ -343,8 +179,10 @@ void require_sampled(const measurements::MeasuredRecord& data) {
 }
 
 /// The step's time on the record's clock ([experiment] step_time, absent: 0), checked against
-/// the record (at least 10 samples, no gap: require_sampled): it must start at most one
-/// sample interval after the step (it sees the response from its start) and end after it.
+/// the record (at least 10 samples, no gap: require_sampled): it must end after the step, and
+/// start at most one sample interval after it — or, a record that started late, within a tenth
+/// of its span after it (the model is simulated from the step and compared from the first
+/// sample); later than that the clocks disagree.
 double checked_step_time(const model::CaseSpec& spec, const measurements::MeasuredRecord& data) {
   if (data.size() < 10) throw std::invalid_argument("the record has fewer than 10 samples");
   require_sampled(data);
@@ -353,7 +191,7 @@ double checked_step_time(const model::CaseSpec& spec, const measurements::Measur
   const double first = data.t.front(), interval = data.t[1] - data.t[0];
   const std::string where = "the step at t = " + shortest_text(step_time) + " s ([experiment] step_time" +
                             (spec.experiment && spec.experiment->step_time ? "" : ", absent: 0") + ")";
-  if (first - step_time > interval)
+  if (first - step_time > interval && first - step_time > 0.1 * (data.t.back() - step_time))
     throw measurements::sample_error(data, 0, "t",
                                      "the record starts at t = " + shortest_text(first) + " s, after " + where +
                                          ": it does not cover the step (give the step's time as [experiment] step_time)");
@@ -366,83 +204,181 @@ double checked_step_time(const model::CaseSpec& spec, const measurements::Measur
 
 }  // namespace
 
-DiscrepancyResult find_discrepancy(const model::CaseSpec& spec, const measurements::MeasuredRecord& data, double step,
-                                   const DiscrepancyOptions& options) {
-  const auto started = std::chrono::steady_clock::now();
-  if (step == 0) throw std::invalid_argument("the step is 0: there is no experiment to compare with");
-  const double step_time = checked_step_time(spec, data);
-  DiscrepancyResult result;
-  const Observations o = observations_of(data, options.holdout_fraction, step);
-  ModelPoint nominal{numeric::parameters_of(spec), numeric::effects_of(spec)};
-  Simulator simulator(o, step, data.t.back(), step_time);
-  simulator.prepare({nominal});
-  std::vector<numeric::SimulationEvent> nominal_events;
-  const auto nominal_traces = simulator.traces(nominal, o.size(), &nominal_events);
-  if (!nominal_traces) throw std::runtime_error("the nominal model could not be simulated over the record");
-  result.noise = o.sigma[0];
-  result.t = o.t;
-  result.theta_measured = o.columns[0];
-  result.theta_nominal = (*nominal_traces)[0];
-  result.nominal_events = nominal_events;
-  Scores current_scores = score(o, *nominal_traces);
-  result.rms_before = current_scores.rms_theta_out;
-  result.gap_before = current_scores.rms();
-  result.first_departure = first_departure(o, result.theta_nominal);
+namespace {
 
-  ModelPoint current = nominal;
-  int current_k = 0;
-  std::vector<EffectCandidate> named_candidates;
-  std::vector<std::string> remaining = options.candidates;
-  while (current_scores.rms() > options.noise_level && static_cast<int>(result.effects.size()) < options.max_effects &&
-         !remaining.empty()) {
-    const auto current_traces = simulator.traces(current, o.size());
-    const double departure = current_traces ? first_departure(o, (*current_traces)[0]) : NAN;
-    std::vector<Trial> trials =
-        round_of(simulator, o, current, current_k, current_scores, departure, remaining, step, options);
-    std::vector<Candidate> round;
-    for (const Trial& t : trials) round.push_back(t.result);
-    result.rounds.push_back(round);
-    const auto winner = std::find_if(trials.begin(), trials.end(), [](const Trial& t) { return t.result.decisive; });
-    if (winner == trials.end()) break;
-    // Refit the winner on the whole record, from its fit on the first part: its uncertainty.
-    const detail::Fit whole = detail::fit_candidate(simulator, o, current, winner->candidate, true, &winner->fit.u);
-    Candidate named = winner->result;
-    ModelPoint point = winner->point;
-    if (whole.ok) {
-      point = winner->candidate.apply(current, whole.values);
-      named.parameters = reported(winner->candidate, whole, point);
-      named.simulations += whole.simulations;
-    }
-    result.effects.push_back(named);
-    named_candidates.push_back(winner->candidate);
-    current = point;
-    current_k += static_cast<int>(winner->candidate.ranges.size());
-    remaining.erase(std::remove(remaining.begin(), remaining.end(), winner->result.effect), remaining.end());
-    const auto traces = simulator.traces(current, o.size());
-    if (!traces) break;
-    current_scores = score(o, *traces);
+// The nominal model's residual read for its noise: spikes flagged (and left out of every index
+// list), then every column's level and theta_out's correlation.
+void read_noise(Observations& o, const std::vector<std::vector<double>>& nominal, double holdout_fraction) {
+  for (std::size_t c = 0; c < o.columns.size(); ++c) {
+    std::vector<double> r(o.size());
+    for (std::size_t i = 0; i < o.size(); ++i) r[i] = o.columns[c][i] - nominal[c][i];
+    const detail::NoiseFit white = detail::noise_of_residual(r, std::vector<char>(o.size(), 0), o.quantum[c], o.floor);
+    detail::flag_spikes(r, white.white_sigma, o.skip);
   }
-  if (result.effects.size() > 1) current = joint_refit(simulator, o, nominal, result.effects, named_candidates, step);
+  split_blocks(o, holdout_fraction);
+  detail::reestimate_noise(o, nominal);
+}
 
+// The outliers listed: every flagged sample, its distance from its neighbours in σ.
+std::vector<Outlier> outliers_of(const Observations& o, const std::vector<std::vector<double>>& model) {
+  static const char* names[] = {"theta_out", "theta_motor", "theta_load"};
+  std::vector<Outlier> out;
+  for (std::size_t i = 1; i + 1 < o.size(); ++i) {
+    if (!o.skip[i]) continue;
+    for (std::size_t c = 0; c < o.columns.size(); ++c) {
+      const auto r = [&](std::size_t k) { return o.columns[c][k] - model[c][k]; };
+      const double size = (r(i) - 0.5 * (r(i - 1) + r(i + 1))) / o.sigma[c];
+      if (c == 0 || std::fabs(size) > std::fabs(out.back().size)) {
+        if (c > 0) out.pop_back();
+        out.push_back({o.t[i], names[o.which[c]], size});
+      }
+    }
+  }
+  return out;
+}
+
+// The nominal parameters corrected, from the candidates named (backlash_size as "backlash").
+std::vector<ParameterCorrection> corrections_of(const std::vector<detail::Named>& named, const numeric::Parameters& nominal,
+                                                const model::CaseSpec& spec) {
+  std::vector<ParameterCorrection> out;
+  for (const detail::Named& n : named) {
+    if (!is_parameter_correction(n.result.effect)) continue;
+    ParameterCorrection c;
+    c.key = n.result.effect == "backlash_size" ? "backlash" : n.result.effect;
+    c.nominal = detail::nominal_value(c.key, nominal);
+    c.fitted = n.result.parameters.front().value;
+    c.uncertainty = n.result.parameters.front().uncertainty;
+    c.ratio = c.nominal != 0 ? c.fitted / c.nominal : NAN;
+    c.given_free = std::find(spec.fit_free.begin(), spec.fit_free.end(), c.key) != spec.fit_free.end();
+    out.push_back(c);
+  }
+  return out;
+}
+
+// The candidates the search tries: the effects asked for, and the nominal parameters but the
+// fixed ones and those fitted first ([fit] free: "backlash" is the candidate backlash_size).
+std::vector<std::string> search_names(const model::CaseSpec& spec, const DiscrepancyOptions& options,
+                                      std::vector<std::string>& free) {
+  auto candidate_name = [](const std::string& key) { return key == "backlash" ? std::string("backlash_size") : key; };
+  std::vector<std::string> fixed;
+  for (const std::string& key : spec.fit_fixed) fixed.push_back(candidate_name(key));
+  for (const std::string& key : spec.fit_free) free.push_back(candidate_name(key));
+  std::vector<std::string> names;
+  for (const std::string& name : options.candidates)
+    if (std::find(fixed.begin(), fixed.end(), name) == fixed.end()) names.push_back(name);
+  for (const std::string& name : options.parameters)
+    if (std::find(fixed.begin(), fixed.end(), name) == fixed.end() && std::find(names.begin(), names.end(), name) == names.end())
+      names.push_back(name);
+  return names;
+}
+
+// The status (docs/discrepancy.md, "Statuses"), from what was named and what remains.
+Status status_of(const detail::Search& s, bool at_noise, bool nominal_at_noise) {
+  if (s.named.empty()) return nominal_at_noise ? Status::NoDiscrepancy : Status::Unexplained;
+  if (!at_noise) return Status::PartlyExplained;
+  if (!s.alike.empty()) return Status::Ambiguous;
+  const bool effect = std::any_of(s.named.begin(), s.named.end(),
+                                  [](const detail::Named& n) { return !is_parameter_correction(n.result.effect); });
+  return effect ? Status::EffectFound : Status::ParametersCorrected;
+}
+
+}  // namespace
+
+namespace detail {
+
+double first_departure(const Observations& o, const std::vector<double>& model) {
+  int run = 0;
+  for (std::size_t i = 0; i < o.size(); ++i) {
+    run = std::fabs(o.columns[0][i] - model[i]) > 3 * o.sigma[0] ? run + 1 : 0;
+    if (run == 5) return o.t[i - 4];
+  }
+  return NAN;
+}
+
+NoiseFit reestimate_noise(Observations& o, const std::vector<std::vector<double>>& traces) {
+  NoiseFit first;
+  for (std::size_t c = 0; c < o.columns.size(); ++c) {
+    std::vector<double> r(o.size());
+    for (std::size_t i = 0; i < o.size(); ++i) r[i] = o.columns[c][i] - traces[c][i];
+    const NoiseFit fit = noise_of_residual(r, o.skip, o.quantum[c], o.floor);
+    o.sigma[c] = fit.sigma;
+    if (c == 0) first = fit;
+  }
+  o.tau_int = first.tau_int;
+  return first;
+}
+
+}  // namespace detail
+
+namespace {
+
+// The result's traces, features, regions and gaps, from the nominal and the corrected model.
+void describe(DiscrepancyResult& result, Simulator& simulator, const Observations& o, const ModelPoint& nominal,
+              const ModelPoint& current, const std::vector<std::vector<double>>& nominal_traces, double step) {
   std::vector<numeric::SimulationEvent> corrected_events;
   const auto corrected = simulator.traces(current, o.size(), &corrected_events);
   result.theta_corrected = corrected ? (*corrected)[0] : result.theta_nominal;
   result.corrected_events = corrected_events;
-  result.rms_after = corrected ? score(o, *corrected).rms_theta_out : result.rms_before;
-  result.gap_after = corrected ? score(o, *corrected).rms() : result.gap_before;
+  const detail::Scores before = detail::score(o, nominal_traces);
+  result.rms_before = before.rms_theta_out;
+  result.gap_before = before.rms();
+  result.rms_after = corrected ? detail::score(o, *corrected).rms_theta_out : result.rms_before;
+  result.gap_after = corrected ? detail::score(o, *corrected).rms() : result.gap_before;
+  result.first_departure = detail::first_departure(o, result.theta_nominal);
+  result.remaining_departure = detail::first_departure(o, result.theta_corrected);
   result.parameters = current.p;
   result.corrected_effects = current.e;
   const double theta_R = nominal.p.theta_R;
   result.measured = features_of(o.t, result.theta_measured, theta_R, step);
   result.nominal = features_of(o.t, result.theta_nominal, theta_R, step);
   result.corrected = features_of(o.t, result.theta_corrected, theta_R, step);
-  result.regions = regions_of(nominal_events, o, result.theta_nominal, result.theta_corrected, nominal.e);
-  if (!result.effects.empty())
-    result.status = Status::EffectFound;
-  else if (score(o, *nominal_traces).rms() <= options.noise_level)
-    result.status = Status::NoDiscrepancy;
-  else
-    result.status = Status::Unexplained;
+  result.regions = regions_of(result.nominal_events, o, result.theta_nominal, result.theta_corrected, nominal.e);
+}
+
+}  // namespace
+
+DiscrepancyResult find_discrepancy(const model::CaseSpec& spec, const measurements::MeasuredRecord& data, double step,
+                                   const DiscrepancyOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  if (step == 0) throw std::invalid_argument("the step is 0: there is no experiment to compare with");
+  const double step_time = checked_step_time(spec, data);
+  DiscrepancyResult result;
+  Observations o = observations_of(data, step);
+  const ModelPoint nominal{numeric::parameters_of(spec), numeric::effects_of(spec)};
+  Simulator simulator(o, step, data.t.back(), step_time);
+  simulator.prepare({nominal});
+  const auto nominal_traces = simulator.traces(nominal, o.size(), &result.nominal_events);
+  if (!nominal_traces) throw std::runtime_error("the nominal model could not be simulated over the record");
+  read_noise(o, *nominal_traces, options.holdout_fraction);
+  std::vector<std::string> free;
+  const std::vector<std::string> names = search_names(spec, options, free);
+  simulator.set_budget(options.total_work);
+  detail::Search s{simulator, o, nominal, step, options, nominal, {}, {}, {}, {}, {}};
+  s.rescore();
+  const bool nominal_at_noise = s.scores.rms() <= detail::at_noise_level(o, options.noise_level);
+  detail::fit_free_parameters(s, free);
+  detail::run_search(s, names);
+  if (simulator.budget_reached())
+    result.reason = "the work budget of " + std::to_string(options.total_work) +
+                    " (1000 per simulation plus its events, more for a delayed model) was reached: the search stopped with what it had";
+  // The noise as the corrected model leaves it, and the gaps in its units.
+  const auto final_traces = simulator.traces(s.current, o.size());
+  const detail::NoiseFit noise = detail::reestimate_noise(o, final_traces ? *final_traces : *nominal_traces);
+  result.noise = o.sigma[0];
+  result.noise_estimate = {noise.sigma, noise.white_sigma, noise.a, noise.tau_int,
+                           static_cast<double>(o.fit_indices.size()) / noise.tau_int, detail::at_noise_level(o, options.noise_level)};
+  result.t = o.t;
+  result.theta_measured = o.columns[0];
+  result.theta_nominal = (*nominal_traces)[0];
+  describe(result, simulator, o, nominal, s.current, *nominal_traces, step);
+  result.outliers = outliers_of(o, *nominal_traces);
+  for (const detail::Named& n : s.named)
+    if (!is_parameter_correction(n.result.effect) || n.result.effect == "backlash_size") result.effects.push_back(n.result);
+  result.parameter_corrections = corrections_of(s.named, nominal.p, spec);
+  result.rounds = s.rounds;
+  result.alternatives = s.alike;
+  result.distinguishing_experiment = s.experiment;
+  result.status = status_of(s, result.gap_after <= result.noise_estimate.at_noise, nominal_at_noise);
   result.simulations = simulator.simulations();
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;

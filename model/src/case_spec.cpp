@@ -298,7 +298,7 @@ class CaseFileReader {
     read_body(root, "load", spec.JL, spec.FL);
 
     if (const toml::node* effects_node = root.get("effects")) spec.effects = read_effects(*effects_node, top_line);
-    if (const toml::node* fit_node = root.get("fit")) spec.fit_free = read_fit(*fit_node, top_line);
+    if (const toml::node* fit_node = root.get("fit")) read_fit(*fit_node, top_line, spec.fit_free, spec.fit_fixed);
     return spec;
   }
 
@@ -347,29 +347,39 @@ class CaseFileReader {
     return parsed;
   }
 
-  /// [fit]: free = ["motor.J", ...] — known names, no repeats.
-  std::vector<std::string> read_fit(const toml::node& node, long fallback_line) const {
+  /// [fit]: free = ["motor.J", ...] and/or fixed = [...] — known names, no repeats, none in both.
+  void read_fit(const toml::node& node, long fallback_line, std::vector<std::string>& free,
+                std::vector<std::string>& fixed) const {
     const toml::table& fit = require_table(node, "fit");
     const long header_line = line_of(fit, fallback_line);
-    reject_unknown_keys(fit, "fit", {"free"});
-    const toml::node& free_node = require(fit, "fit", header_line, "free");
-    const toml::array* names = free_node.as_array();
+    reject_unknown_keys(fit, "fit", {"free", "fixed"});
+    if (fit.get("fixed") == nullptr) require(fit, "fit", header_line, "free");
+    if (const toml::node* free_node = fit.get("free")) free = read_fit_names(*free_node, header_line, "fit.free", {});
+    if (const toml::node* fixed_node = fit.get("fixed"))
+      fixed = read_fit_names(*fixed_node, header_line, "fit.fixed", free);
+  }
+
+  /// One list of [fit]: known names, no repeats, none of `other` (the free list).
+  std::vector<std::string> read_fit_names(const toml::node& list, long header_line, const std::string& key,
+                                          const std::vector<std::string>& other) const {
+    const toml::array* names = list.as_array();
     if (names == nullptr)
-      fail(line_of(free_node, header_line), "fit.free",
-           std::string("expected an array of parameter names, got ") + describe_node_type(free_node));
+      fail(line_of(list, header_line), key, std::string("expected an array of parameter names, got ") + describe_node_type(list));
     std::vector<std::string> out;
     for (const toml::node& entry : *names) {
       const auto* text = entry.as_string();
       const auto& known = fittable_parameters();
+      const long line = line_of(entry, line_of(list, header_line));
       if (text == nullptr || std::find(known.begin(), known.end(), text->get()) == known.end()) {
         std::string allowed;
         for (const std::string& k : known) allowed += (allowed.empty() ? "" : ", ") + k;
-        fail(line_of(entry, line_of(free_node, header_line)), "fit.free",
+        fail(line, key,
              "unknown parameter " + (text ? "\"" + text->get() + "\"" : std::string(describe_node_type(entry))) +
                  " (allowed: " + allowed + ")");
       }
-      if (std::find(out.begin(), out.end(), text->get()) != out.end())
-        fail(line_of(entry, line_of(free_node, header_line)), "fit.free", "\"" + text->get() + "\" given twice");
+      if (std::find(out.begin(), out.end(), text->get()) != out.end()) fail(line, key, "\"" + text->get() + "\" given twice");
+      if (std::find(other.begin(), other.end(), text->get()) != other.end())
+        fail(line, key, "\"" + text->get() + "\" is also in fit.free: a parameter is free or fixed, not both");
       out.push_back(text->get());
     }
     return out;

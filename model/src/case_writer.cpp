@@ -70,9 +70,11 @@ std::string write_case_file(const CaseFileText& c) {
     out << blank;
     write_experiment(out, *c.experiment);
   }
-  if (!c.fit_free.empty()) {
-    out << blank << "[fit]\nfree = [";
-    for (std::size_t i = 0; i < c.fit_free.size(); ++i) out << (i ? ", " : "") << toml_string(c.fit_free[i]);
+  if (!c.fit_free.empty() || !c.fit_fixed.empty()) out << blank << "[fit]\n";
+  for (const auto& [key, names] : {std::pair{"free", &c.fit_free}, std::pair{"fixed", &c.fit_fixed}}) {
+    if (names->empty()) continue;
+    out << key << " = [";
+    for (std::size_t i = 0; i < names->size(); ++i) out << (i ? ", " : "") << toml_string((*names)[i]);
     out << "]\n";
   }
   write_effects(out, c, blank);
@@ -97,6 +99,7 @@ std::string write_case_file(const CaseSpec& s) {
       if (const std::optional<Rational>& v = field(s.effects, effect_parameters[i].id)) c.effects[i] = exact_text(*v);
   }
   c.fit_free = s.fit_free;
+  c.fit_fixed = s.fit_fixed;
   return write_case_file(c);
 }
 

@@ -494,6 +494,17 @@ void bind_records_and_discrepancy(py::module_& m) {
         for (const discrepancy::Candidate& c : named) out.append(candidate_dict(c));
         return out;
       })
+      .def_property_readonly("parameter_corrections", [](const api::Discrepancy& d) {
+        py::list out;  // a step record's corrected nominal parameters (docs/discrepancy.md)
+        if (d.step_result())
+          for (const discrepancy::ParameterCorrection& c : d.step_result()->parameter_corrections) {
+            py::dict x;
+            x["key"] = c.key, x["nominal"] = c.nominal, x["fitted"] = c.fitted, x["sigma"] = c.uncertainty;
+            x["ratio"] = c.ratio, x["given_free"] = c.given_free;
+            out.append(x);
+          }
+        return out;
+      })
       .def_property_readonly("rms_before", [](const api::Discrepancy& d) {
         return d.step_result() ? d.step_result()->rms_before : d.drive_result()->rms_before;
       })

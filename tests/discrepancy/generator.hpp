@@ -25,6 +25,13 @@ struct RecordSpec {
   double quantum = 0;             ///< encoder resolution [rad] (0: none)
   bool motor_column = false, load_column = false;
   std::uint64_t seed = 1;
+  // Measurement as real machines make it (all off by default: the records above are unchanged).
+  double noise_correlation = 0;   ///< AR(1) noise, correlation length in samples (a = e^(−1/ℓ)); 0: white
+  double spike_fraction = 0;      ///< this fraction of samples gets a spike of ±spike_size σ
+  double spike_size = 20;
+  double jitter = 0;              ///< each time stamp moved by up to ±jitter sample intervals (uniform)
+  double start = 0;               ///< samples before this time are dropped (a record started late)
+  double drift = 0;               ///< a sensor drift [rad/s] added to every column (outside the vocabulary)
 };
 
 /// The record, or throws std::runtime_error when the simulation does not end normally.

@@ -345,8 +345,10 @@ TEST_F(CaseFileVariants, FitNamesTheFreeNominalParameters) {
                   "\"K\" given twice");
   expect_rejected(drive_model({"kind = \"drive\""}, {"[fit]", "free = \"motor.J\""}), 14, "fit.free",
                   "expected an array of parameter names, got a string");
-  expect_rejected(drive_model({"kind = \"drive\""}, {"[fit]", "fixed = []"}), 14, "fit.fixed",
-                  "unknown key (allowed: free)");
+  expect_rejected(drive_model({"kind = \"drive\""}, {"[fit]", "pinned = []"}), 14, "fit.pinned",
+                  "unknown key (allowed: free, fixed)");
+  expect_rejected(drive_model({"kind = \"drive\""}, {"[fit]", "free = [\"K\"]", "fixed = [\"K\"]"}), 15, "fit.fixed",
+                  "\"K\" is also in fit.free: a parameter is free or fixed, not both");
 }
 
 TEST_F(CaseFileVariants, OnlyASmallRegularFileIsRead) {

@@ -34,8 +34,17 @@
 //   4. reports the named effects with their parameters and uncertainties, the RMS
 //      before and after (total and per region), the candidates' scores, and the
 //      corrected model.
-// Statuses: effect_found, no_discrepancy (the model already fits to the noise
-// level), unexplained (a gap no candidate closes decisively; the best is shown).
+//   Nominal parameters are candidates too (motor.J, motor.F, load.J, load.F, K, reference, and the
+//   backlash — still tried under its old name backlash_size): judged by the same rule and
+//   reported apart as parameter corrections; [fit] free lists those fitted first, [fit] fixed
+//   those never corrected.  The noise is estimated with its correlation (an AR(1) fitted to
+//   the lagged fourth differences of the nominal model's residual) and the BIC counts
+//   n_eff = n/τ_int residuals; isolated spikes are listed as outliers and given no weight.
+// Statuses (docs/discrepancy.md): effect_found (effects named, the corrected model meets the record
+// at the noise level), parameters_corrected (corrections of nominal parameters alone do),
+// partly_explained (something named, a gap above the noise remains), ambiguous (two explanations
+// fit alike: both listed, with the experiment that would tell them apart), no_discrepancy (the
+// model already fits to the noise level), unexplained (a gap no candidate closes decisively).
 #pragma once
 
 #include "backlash/measurements/measured_record.hpp"
@@ -51,11 +60,19 @@
 
 namespace backlash::discrepancy {
 
-enum class Status { EffectFound, NoDiscrepancy, Unexplained };
+enum class Status { EffectFound, NoDiscrepancy, Unexplained, ParametersCorrected, PartlyExplained, Ambiguous };
 const char* to_string(Status status);
 
 /// The effects the workflow can name (effects.md), in the order they are tried.
 const std::vector<std::string>& vocabulary();
+
+/// The nominal parameters a step record may correct, as [fit] free / fixed name them
+/// (model::fittable_parameters() but "backlash", which is tried as the candidate backlash_size).
+const std::vector<std::string>& parameter_candidates();
+
+/// True for a candidate that corrects a nominal parameter (a key of parameter_candidates(), or
+/// backlash_size — the backlash correction's deprecated name as an effect, kept for one release).
+bool is_parameter_correction(const std::string& candidate);
 
 struct Parameter {
   std::string name;  ///< "torque", "e", "limit", "stiffness", "damping", "tau", "backlash"
@@ -96,6 +113,33 @@ struct Features {
   double cycle_period = NAN;     ///< from the crossings of the last third's mean
 };
 
+/// A nominal parameter corrected by the record.
+struct ParameterCorrection {
+  std::string key;           ///< "motor.J", "motor.F", "load.J", "load.F", "K", "backlash", "reference"
+  double nominal = 0;        ///< the case file's value
+  double fitted = 0;
+  double uncertainty = NAN;  ///< one standard deviation
+  double ratio = 1;          ///< fitted / nominal (NaN for a nominal 0)
+  bool given_free = false;   ///< listed in [fit] free (fitted first)
+};
+
+/// A sample the fit gives no weight: an isolated spike (docs/discrepancy.md, "Noise").
+struct Outlier {
+  double t = 0;
+  std::string column;  ///< "theta_out", "theta_motor", "theta_load"
+  double size = 0;     ///< its distance from its neighbours' median, in units of σ
+};
+
+/// The noise of theta_out as estimated from the nominal model's residual.
+struct NoiseEstimate {
+  double sigma = 0;        ///< its level [rad]
+  double white_sigma = 0;  ///< the white-noise rule alone (MAD(Δ⁴y)/(0.6745·√70)) [rad]
+  double correlation = 0;  ///< the AR(1) coefficient a per sample (0: white)
+  double tau_int = 1;      ///< (1 + a)/(1 − a) [samples]
+  double n_eff = 0;        ///< n/τ_int of the fitted samples, the n of the BIC
+  double at_noise = 1.15;  ///< the RMS (in σ) at or below which a model meets the record
+};
+
 struct DiscrepancyOptions {
   double holdout_fraction = 0.3;  ///< the blocks held out of every fit (every third of ten)
   double decisive_bic = 10;       ///< a "very strong" BIC difference (Kass & Raftery)
@@ -108,6 +152,15 @@ struct DiscrepancyOptions {
   /// events it simulated — reaches this (a stiff mesh can be slow).  A count, not a clock, so that
   /// the result is the same on any machine; 3e6 is about 3 s of a stiff mesh's fit here.
   long candidate_work = 3'000'000;
+  /// The whole search stops (status reason "the work budget ... was reached") when the work of
+  /// all its fits reaches this: sized so that a step record of a few thousand samples answers in
+  /// at most 20 s on one core (bench/time_discrepancy_records.sh).
+  /// (A delayed model's simulation counts more: 400 per radian of its fastest oscillation over the
+  /// record, about 12000 for a delayed case V over 30 s — it is integrated numerically.)
+  long total_work = 50'000'000;
+  /// The nominal parameters tried as corrections (default: all; [fit] fixed removes some).
+  std::vector<std::string> parameters = parameter_candidates();
+  double ambiguity_bic = 2;       ///< two explanations whose BIC differ by less are alike
   /// Set: called as each candidate of a round is fitted, `done` of the round's `total`
   /// candidates (from the worker threads, serialised); a new round starts again from 0.
   std::function<void(long done, long total)> progress{};
@@ -119,7 +172,18 @@ struct DiscrepancyResult {
   double rms_before = 0, rms_after = 0;  ///< of theta_out [rad]
   double gap_before = 0, gap_after = 0;  ///< RMS over every measured column, in units of each column's σ
   double first_departure = NAN;      ///< first time the residual leaves the noise band (NaN: never)
-  std::vector<Candidate> effects;    ///< named, in the order found
+  std::vector<Candidate> effects;    ///< named, in the order found (backlash_size included: deprecated)
+  std::vector<ParameterCorrection> parameter_corrections;  ///< nominal parameters corrected
+  NoiseEstimate noise_estimate;
+  std::vector<Outlier> outliers;
+  /// Ambiguous: the explanations that fit alike (the one adopted first), and the experiment that
+  /// would tell them apart.
+  std::vector<Candidate> alternatives;
+  std::string distinguishing_experiment;
+  /// Why the search stopped short when it did (the work budget reached), else empty.
+  std::string reason;
+  /// Partly explained: where the corrected model still leaves the noise band (NaN: nowhere).
+  double remaining_departure = NAN;
   std::vector<std::vector<Candidate>> rounds;  ///< every candidate of every round, best first
   std::vector<Region> regions;
   Features measured, nominal, corrected;

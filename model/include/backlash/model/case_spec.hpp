@@ -74,6 +74,9 @@ struct CaseSpec {
   /// [fit] free = [...]: the nominal parameters a record may correct ("motor.J", "motor.F",
   /// "load.J", "load.F", "K", "backlash", "reference"), fitted before any effect is sought.
   std::vector<std::string> fit_free;
+  /// [fit] fixed = [...]: the nominal parameters the user trusts — a step record's discrepancy
+  /// search never corrects them (same names as fit_free, none in both).
+  std::vector<std::string> fit_fixed;
 };
 
 /// The names [fit] free accepts, in this order.

@@ -46,7 +46,7 @@ struct CaseFileText {
   std::optional<ExperimentText> experiment;
   /// The effect parameters present (table order); an effect is written when its first parameter is.
   std::array<std::optional<std::string>, kEffectParameterCount> effects;
-  std::vector<std::string> fit_free;
+  std::vector<std::string> fit_free, fit_fixed;
 };
 
 /// The effects of a fitted model (numeric::Effects: doubles, `has(effect)`) as the texts of

@@ -1,0 +1,412 @@
+// The search for what a model is missing (docs/discrepancy.md, "The search"): rounds of
+// candidates — effects and nominal parameters — judged by one decisive rule, pairs where no
+// single candidate is decisive, everything named refitted together, and a named candidate that
+// the later ones make needless replaced.
+#include "internal.hpp"
+
+#include "backlash/model/effect_table.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <thread>
+
+namespace backlash::discrepancy::detail {
+
+Scores score(const Observations& o, const std::vector<std::vector<double>>& traces) {
+  Scores s;
+  const std::vector<double> fit = residuals(o, traces, o.fit_indices);
+  const std::vector<double> held = residuals(o, traces, o.holdout_indices);
+  s.sse_fit = sum_of_squares(fit);
+  s.sse_holdout = sum_of_squares(held);
+  s.sse = s.sse_fit + s.sse_holdout;
+  s.n_fit = fit.size();
+  s.n_holdout = held.size();
+  s.n = s.n_fit + s.n_holdout;
+  s.tau_int = o.tau_int;
+  double sum = 0;
+  for (std::size_t i : o.all_indices) sum += (o.columns[0][i] - traces[0][i]) * (o.columns[0][i] - traces[0][i]);
+  s.rms_theta_out = std::sqrt(sum / std::max<std::size_t>(1, o.all_indices.size()));
+  return s;
+}
+
+double at_noise_level(const Observations& o, double noise_level) {
+  const double n = static_cast<double>(std::max<std::size_t>(1, o.all_indices.size() * o.columns.size()));
+  return std::max(noise_level, 1 + 3 * std::sqrt(o.tau_int / (2 * n)));
+}
+
+int Search::parameters() const {
+  int k = 0;
+  for (const Named& n : named) k += static_cast<int>(n.candidate.ranges.size());
+  return k;
+}
+
+bool Search::rescore() {
+  const auto traces = simulator.traces(current, o.size());
+  if (!traces) return false;
+  scores = score(o, *traces);
+  return true;
+}
+
+namespace {
+
+// A named candidate's parameters as reported (the compliance's damping from its ratio).
+std::vector<Parameter> reported(const EffectCandidate& c, const std::vector<double>& values,
+                                const std::vector<double>& uncertainty, const ModelPoint& point) {
+  std::vector<Parameter> out;
+  for (std::size_t i = 0; i < c.ranges.size(); ++i)
+    out.push_back({c.ranges[i].name, values[i], uncertainty.empty() ? NAN : uncertainty[i]});
+  if (c.effect == "compliance") {
+    const double ratio = values[1], ratio_sigma = out[1].uncertainty;
+    const double scale = point.e.mesh_damping / ratio;
+    out[1] = {"damping", point.e.mesh_damping, ratio_sigma * scale};
+  }
+  return out;
+}
+
+// The fit's coordinate u of a named candidate's reported parameter (the compliance's damping
+// back to its ratio).
+double coordinate_of(const EffectCandidate& c, const std::vector<Parameter>& ps, std::size_t j, const ModelPoint& base) {
+  const ParameterRange& r = c.ranges[j];
+  double value = ps[j].value;
+  if (c.effect == "compliance" && j == 1)
+    value = value / (2 * std::sqrt(ps[0].value * base.p.Jm * base.p.JL / (base.p.Jm + base.p.JL)));
+  const double u = r.logarithmic ? std::log(value / r.low) / std::log(r.high / r.low) : (value - r.low) / (r.high - r.low);
+  return std::min(1.0, std::max(0.0, u));
+}
+
+struct Trial {
+  EffectCandidate candidate;
+  Fit fit;
+  Candidate result;
+  ModelPoint point;
+};
+
+// A fitted trial scored against the current model by the decisive rule (docs/discrepancy.md).
+void judge(Trial& t, const Search& s, int current_k) {
+  const DiscrepancyOptions& options = s.options;
+  t.point = t.candidate.apply(s.current, t.fit.values);
+  const auto traces = s.simulator.traces(t.point, s.o.size());
+  if (!traces) {
+    t.fit.ok = false;
+    return;
+  }
+  const Scores sc = score(s.o, *traces);
+  ++t.result.simulations;
+  t.result.parameters = reported(t.candidate, t.fit.values, t.fit.uncertainty, t.point);
+  t.result.rms = sc.rms_theta_out;
+  t.result.rms_fit = sc.rms_fit();
+  t.result.rms_holdout = sc.rms_holdout();
+  const int k = current_k + static_cast<int>(t.candidate.ranges.size());
+  t.result.bic = sc.bic(k);
+  t.result.delta_bic = t.result.bic - s.scores.bic(current_k);
+  // Decisive on both: the BIC, and the held-out samples — they must shrink, or, when the model
+  // already meets them at the noise level, at least not get worse.
+  const double held = s.scores.rms_holdout();
+  const bool confirmed = t.result.rms_holdout < options.decisive_holdout * held ||
+                         (held <= options.noise_level && t.result.rms_holdout <= 1.02 * held);
+  // A parameter pinned at the edge of its range cannot be told from that limit: not decisive.
+  t.result.at_range_edge = std::any_of(t.fit.u.begin(), t.fit.u.end(), [](double u) { return u < 1e-3 || u > 1 - 1e-3; });
+  t.result.decisive = t.result.delta_bic < -options.decisive_bic && confirmed && !t.result.at_range_edge;
+}
+
+// One trial: the candidate built around the current model, fitted, judged.
+void run_trial(Trial& t, Search& s, const std::string& name, double departure, const std::vector<double>* start) {
+  const auto started = std::chrono::steady_clock::now();
+  t.result.effect = name;
+  try {
+    if (t.candidate.ranges.empty()) t.candidate = candidate_for(name, s.current, s.step);
+    // A pair (started from its singles' fits) gets a quarter of a single candidate's budget.
+    const long budget = start ? s.options.candidate_work / 4 : s.options.candidate_work;
+    t.fit = fit_candidate(s.simulator, s.o, s.current, t.candidate, false, start, budget, departure);
+    if (t.fit.budget_exhausted)
+      t.result.failure = s.simulator.budget_reached()
+                             ? "the search's work budget of " + std::to_string(s.options.total_work) + " was reached"
+                             : "its fit reached the work budget of " + std::to_string(s.options.candidate_work) +
+                                   " (1000 per simulation plus its events)";
+  } catch (const std::exception& error) {  // a candidate that cannot be built or simulated has failed
+    t.fit = Fit{};
+    t.result.failure = error.what();
+  }
+  t.result.simulations = t.fit.simulations;
+  if (t.fit.ok) judge(t, s, s.parameters());
+  if (!t.fit.ok) t.result.bic = t.result.rms = t.result.rms_holdout = INFINITY;
+  t.result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+}
+
+// Every candidate of a round, fitted on the first part and scored (threads over candidates).
+std::vector<Trial> round_of(Search& s, double departure, const std::vector<std::string>& names) {
+  std::vector<Trial> trials(names.size());
+  std::atomic<std::size_t> next{0};
+  std::mutex progress_mutex;
+  long finished = 0;
+  auto work = [&] {
+    for (std::size_t i = next++; i < trials.size(); i = next++) {
+      run_trial(trials[i], s, names[i], departure, nullptr);
+      if (!s.options.progress) continue;
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      s.options.progress(++finished, static_cast<long>(trials.size()));
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int k = 1; k < std::max(1, s.options.threads); ++k) pool.emplace_back(work);
+  work();
+  for (std::thread& th : pool) th.join();
+  std::stable_sort(trials.begin(), trials.end(), [](const Trial& a, const Trial& b) { return a.result.bic < b.result.bic; });
+  return trials;
+}
+
+// Torque levels (they do not scale with the step) and the shaft an explanation lives on.
+bool torque_level(const std::string& name) {
+  return name.find("coulomb") != std::string::npos || name == "saturation" || name == "torque_offset" ||
+         name.find("stribeck") != std::string::npos;
+}
+int shaft_of(const std::string& name) {
+  if (name.find("motor") != std::string::npos) return 1;
+  if (name.find("load") != std::string::npos) return 2;
+  return 0;
+}
+
+// The experiment that would tell two explanations apart.
+std::string experiment_between(const std::string& a, const std::string& b) {
+  if (shaft_of(a) != 0 && shaft_of(b) != 0 && shaft_of(a) != shaft_of(b))
+    return "the other shaft measured (theta_motor and theta_load columns): the two act on different bodies";
+  if (torque_level(a) != torque_level(b))
+    return "a larger or a smaller step: a torque level does not scale with the step, a linear term does";
+  return "a longer record: the two differ most in how the motion settles";
+}
+
+// The decisive trial named: the best by BIC, but a nominal parameter's correction where one fits
+// within ambiguity_bic of an effect (no new physics where a wrong number explains the record).
+const Trial* choose(const std::vector<Trial>& trials, const Search& s) {
+  const double alike = s.options.ambiguity_bic;
+  const auto best = std::find_if(trials.begin(), trials.end(), [](const Trial& t) { return t.result.decisive; });
+  if (best == trials.end()) return nullptr;
+  const Trial* chosen = &*best;
+  if (!is_parameter_correction(chosen->result.effect))
+    for (const Trial& t : trials)
+      if (t.result.decisive && is_parameter_correction(t.result.effect) && t.result.bic < best->result.bic + alike) {
+        chosen = &t;
+        break;
+      }
+  return chosen;
+}
+
+// The other decisive trials within ambiguity_bic of the one named: explanations alike.
+void record_alike(const std::vector<Trial>& trials, const Trial* chosen, Search& s) {
+  const double alike = s.options.ambiguity_bic;
+  for (const Trial& t : trials)
+    if (&t != chosen && t.result.decisive && std::fabs(t.result.bic - chosen->result.bic) < alike) {
+      if (s.alike.empty()) s.alike.push_back(chosen->result);
+      s.alike.push_back(t.result);
+      if (s.experiment.empty()) s.experiment = experiment_between(chosen->result.effect, t.result.effect);
+    }
+}
+
+// Two contact laws cannot be combined (each puts the others back to neutral): refused by name.
+std::string combination_problem(const std::string& a, const std::string& b) {
+  const model::EffectInfo* x = model::effect_keyed(a);
+  const model::EffectInfo* y = model::effect_keyed(b);
+  if (x && y && x->contact_law && y->contact_law)
+    return a + " and " + b + " cannot be combined: both are contact laws (one law at the contact)";
+  return "";
+}
+
+// Every pair of the round's best four, fitted together
+// from their single fits and judged with both parameters' penalty.  The best decisive pair, or nothing.
+std::optional<Trial> best_pair(Search& s, const std::vector<Trial>& singles, double departure, std::vector<Candidate>& round) {
+  std::vector<const Trial*> top;
+  for (const Trial& t : singles)
+    if (t.fit.ok && top.size() < 4) top.push_back(&t);
+  std::optional<Trial> best;
+  for (std::size_t i = 0; i < top.size(); ++i)
+    for (std::size_t j = i + 1; j < top.size(); ++j) {
+      Trial pair;
+      pair.candidate = combined({top[i]->candidate, top[j]->candidate});
+      if (const std::string problem = combination_problem(top[i]->result.effect, top[j]->result.effect); !problem.empty()) {
+        pair.result.effect = pair.candidate.effect;
+        pair.result.failure = problem;
+        pair.result.bic = pair.result.rms = pair.result.rms_holdout = INFINITY;
+        round.push_back(pair.result);
+        continue;
+      }
+      std::vector<double> start = top[i]->fit.u;
+      start.insert(start.end(), top[j]->fit.u.begin(), top[j]->fit.u.end());
+      run_trial(pair, s, pair.candidate.effect, departure, &start);
+      round.push_back(pair.result);
+      if (pair.result.decisive && (!best || pair.result.bic < best->result.bic)) best = std::move(pair);
+    }
+  return best;
+}
+
+// Everything named refitted together on the whole record from `base`, from their current values;
+// each named candidate's parameters updated.  Returns the model, or nothing if the fit failed.
+std::optional<ModelPoint> joint_refit(Search& s, std::vector<Named>& named) {
+  if (named.empty()) return s.base;
+  std::vector<EffectCandidate> parts;
+  std::vector<double> start;
+  for (const Named& n : named) {
+    parts.push_back(n.candidate);
+    for (std::size_t j = 0; j < n.candidate.ranges.size(); ++j)
+      start.push_back(coordinate_of(n.candidate, n.result.parameters, j, s.base));
+  }
+  const EffectCandidate joint = combined(parts);
+  const Fit fit = fit_candidate(s.simulator, s.o, s.base, joint, true, &start);
+  if (!fit.ok) return std::nullopt;
+  const ModelPoint point = joint.apply(s.base, fit.values);
+  std::size_t at = 0;
+  for (Named& n : named) {
+    const std::size_t k = n.candidate.ranges.size();
+    const std::vector<double> values(fit.values.begin() + at, fit.values.begin() + at + k);
+    const std::vector<double> sigma(fit.uncertainty.begin() + at, fit.uncertainty.begin() + at + k);
+    n.result.parameters = reported(n.candidate, values, sigma, point);
+    n.result.simulations += fit.simulations;
+    at += k;
+  }
+  return point;
+}
+
+// A named candidate the others make needless — the model without it, refitted, is not decisively
+// worse on the whole record (ΔBIC < decisive_bic) — is dropped (the first one named is not kept
+// just because it came first).  Returns the name dropped, or "".
+std::string replace_needless(Search& s) {
+  if (s.named.size() < 2) return "";
+  const int k = s.parameters();
+  const double bic_all = s.scores.bic(k);
+  for (std::size_t i = 0; i < s.named.size(); ++i) {
+    std::vector<Named> others = s.named;
+    others.erase(others.begin() + static_cast<std::ptrdiff_t>(i));
+    const auto point = joint_refit(s, others);
+    if (!point) continue;
+    const auto traces = s.simulator.traces(*point, s.o.size());
+    if (!traces) continue;
+    const Scores without = score(s.o, *traces);
+    if (without.bic(k - static_cast<int>(s.named[i].candidate.ranges.size())) - bic_all < s.options.decisive_bic) {
+      const std::string dropped = s.named[i].result.effect;
+      s.named = std::move(others);
+      s.current = *point;
+      s.scores = without;
+      return dropped;
+    }
+  }
+  return "";
+}
+
+// Names a trial: refitted on the whole record from its fit (its uncertainty), added.
+void name_trial(Search& s, const Trial& t) {
+  const Fit whole = fit_candidate(s.simulator, s.o, s.current, t.candidate, true, &t.fit.u);
+  Named n{t.result, t.candidate};
+  ModelPoint point = t.point;
+  if (whole.ok) {
+    point = t.candidate.apply(s.current, whole.values);
+    n.result.parameters = reported(t.candidate, whole.values, whole.uncertainty, point);
+    n.result.simulations += whole.simulations;
+  }
+  s.named.push_back(n);
+  s.current = point;
+}
+
+// Names a decisive pair: each part with its slice of the pair's fit.
+void name_pair(Search& s, const Trial& pair, const std::vector<Trial>& singles) {
+  std::size_t at = 0;
+  for (const std::string& part : {pair.result.effect.substr(0, pair.result.effect.find(" + ")),
+                                  pair.result.effect.substr(pair.result.effect.find(" + ") + 3)}) {
+    const auto single = std::find_if(singles.begin(), singles.end(), [&](const Trial& t) { return t.result.effect == part; });
+    Named n{single->result, single->candidate};
+    const std::size_t k = single->candidate.ranges.size();
+    n.result.parameters = reported(n.candidate, std::vector<double>(pair.fit.values.begin() + at, pair.fit.values.begin() + at + k),
+                                   {}, pair.point);
+    n.result.delta_bic = pair.result.delta_bic;
+    n.result.decisive = true;
+    s.named.push_back(n);
+    at += k;
+  }
+  s.current = pair.point;
+}
+
+}  // namespace
+
+void fit_free_parameters(Search& s, const std::vector<std::string>& free) {
+  if (free.empty()) return;
+  std::vector<Named> named;
+  std::vector<EffectCandidate> parts;
+  for (const std::string& key : free) {
+    Named n;
+    n.candidate = candidate_for(key, s.base, s.step);  // a parameter at 0 is refused here
+    n.result.effect = key;
+    named.push_back(n);
+    parts.push_back(n.candidate);
+  }
+  // One or two: the scan and the growing horizons, as for a candidate; more: from the nominal values.
+  const EffectCandidate joint = combined(parts);
+  std::vector<double> start;
+  for (const Named& n : named) {
+    const ParameterRange& r = n.candidate.ranges[0];
+    const double v = nominal_value(n.result.effect, s.base.p);
+    start.push_back(r.logarithmic ? std::log(v / r.low) / std::log(r.high / r.low) : (v - r.low) / (r.high - r.low));
+  }
+  const auto traces0 = s.simulator.traces(s.base, s.o.size());
+  const double departure = traces0 ? first_departure(s.o, (*traces0)[0]) : NAN;
+  const Fit fit = fit_candidate(s.simulator, s.o, s.base, joint, true, free.size() <= 2 ? nullptr : &start,
+                                std::numeric_limits<long>::max(), departure);
+  if (!fit.ok) return;
+  const ModelPoint point = joint.apply(s.base, fit.values);
+  const auto traces = s.simulator.traces(point, s.o.size());
+  if (!traces) return;
+  const Scores fitted = score(s.o, *traces);
+  const double delta = fitted.bic(static_cast<int>(free.size())) - s.scores.bic(0);
+  if (!(delta < -s.options.decisive_bic)) return;
+  for (std::size_t i = 0; i < named.size(); ++i) {
+    named[i].result.parameters = {{named[i].candidate.ranges[0].name, fit.values[i], fit.uncertainty[i]}};
+    named[i].result.delta_bic = delta, named[i].result.decisive = true;
+  }
+  s.named = std::move(named);
+  s.current = point;
+  s.scores = fitted;
+}
+
+void run_search(Search& s, std::vector<std::string> remaining) {
+  auto erase = [&](const std::string& name) { remaining.erase(std::remove(remaining.begin(), remaining.end(), name), remaining.end()); };
+  for (const Named& n : s.named) erase(n.result.effect);
+  auto go_on = [&](int round) {
+    return round < s.options.max_effects + 2 && s.scores.rms() > at_noise_level(s.o, s.options.noise_level) &&
+           static_cast<int>(s.named.size()) < s.options.max_effects && !remaining.empty() && !s.simulator.budget_reached();
+  };
+  for (int rounds = 0; go_on(rounds); ++rounds) {
+    const auto current_traces = s.simulator.traces(s.current, s.o.size());
+    const double departure = current_traces ? first_departure(s.o, (*current_traces)[0]) : NAN;
+    const std::vector<Trial> trials = round_of(s, departure, remaining);
+    std::vector<Candidate> round;
+    for (const Trial& t : trials) round.push_back(t.result);
+    const std::size_t before = s.named.size();
+    // Pairs where no single candidate is decisive or the best one leaves a gap above the noise;
+    // a pair replaces the best single one when decisively better (ΔBIC < −decisive_bic between them).
+    const Trial* winner = choose(trials, s);
+    std::optional<Trial> pair;
+    if (static_cast<int>(s.named.size()) + 2 <= s.options.max_effects &&
+        (!winner || winner->result.rms_fit > at_noise_level(s.o, s.options.noise_level)))
+      pair = best_pair(s, trials, departure, round);
+    if (pair && (!winner || pair->result.bic < winner->result.bic - s.options.decisive_bic)) {
+      name_pair(s, *pair, trials);
+    } else if (winner) {
+      record_alike(trials, winner, s);
+      name_trial(s, *winner);
+    }
+    s.rounds.push_back(round);
+    if (s.named.size() == before) break;
+    for (std::size_t i = before; i < s.named.size(); ++i) erase(s.named[i].result.effect);
+    if (s.named.size() > 1)
+      if (const auto point = joint_refit(s, s.named)) s.current = *point;
+    if (!s.rescore()) break;
+    replace_needless(s);  // a dropped candidate is not tried again
+    // The noise re-read from what the model now leaves: a large gap hides the noise's colour.
+    if (const auto traces = s.simulator.traces(s.current, s.o.size())) {
+      reestimate_noise(s.o, *traces);
+      s.rescore();
+    }
+  }
+}
+
+}  // namespace backlash::discrepancy::detail
