@@ -256,11 +256,9 @@ numeric::HybridState admitted_start(const numeric::Parameters& p, const numeric:
   if (!s.in_contact) {
     if (p.backlash <= 0) throw BadInput("from", "a rigid drive (backlash 0) has no free flight: start in contact");
     if (std::fabs(x) > half + slack) throw BadInput("from", gap + " is outside the backlash" + faces);
-    if (!at_face)
-      throw BadInput("from", gap + " is inside the backlash" + faces + ": a free flight starts on the face it leaves "
-                                 "(the simulators' flights run from a face; docs/design.md, \"simulate --from\")");
-    h.face = x > 0 ? +1 : -1;
-    refuse_closing_flight(p, e, h);
+    // Strictly inside (numeric::inside_backlash, the same rounding rule): any velocities, the face
+    // σ the nearer one (x > 0: +b/2, else −b/2); on a face: a flight leaving it.
+    if (at_face) refuse_closing_flight(p, e, h);
   } else if (e.compliant()) {
     if (std::fabs(x) < half - slack)
       throw BadInput("from", gap + " is inside the backlash: the mesh is engaged only at or beyond a face" + faces +

@@ -42,6 +42,16 @@ std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef
   return std::nullopt;
 }
 
+std::optional<GapEvent> first_gap_event_inside(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
+                                               double start_gap, int face, double half, double horizon) {
+  const std::optional<Crossing> same = first_crossing(gap_mode, sample, face * half - start_gap, 0, horizon);
+  const std::optional<Crossing> opposite =
+      first_crossing(gap_mode, sample, -face * half - start_gap, 0, same ? same->t : horizon);
+  if (opposite && (!same || opposite->t < same->t)) return GapEvent{GapEventKind::OppositeFace, *opposite, 0, true};
+  if (same) return GapEvent{GapEventKind::FaceLeft, *same, 0, true};
+  return std::nullopt;
+}
+
 std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
                                         std::function<double(double)> gap_change, double opposite_face_change,
                                         double horizon, double position_scale, double time_unit) {

@@ -16,6 +16,7 @@ struct GapEvent {
   GapEventKind kind;
   Crossing crossing;
   double departure = 0;  ///< FaceLeft: the certified departure t0, w ≠ 0 on (0, t0], the search's start
+  bool from_inside = false;  ///< the flight started strictly inside the backlash (no face left, no departure)
 };
 
 /// The witness of the gap change Δx = θL − θm − Δx(0) − level of a free flight.
@@ -34,6 +35,13 @@ std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::
 /// segment), `sample(t)` giving x(t) and Δx(t) from one closed-form evaluation.
 std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
                                         double opposite_face_change, double horizon, double position_scale);
+
+/// A free flight that starts strictly inside the backlash, at the gap x(0) = `start_gap`
+/// (|x(0)| < b/2 = `half`): the first arrival of x at a face — Δx = σ b/2 − x(0) (FaceLeft: the
+/// face σ = `face`) or −σ b/2 − x(0) (OppositeFace) — by the certified search of both levels,
+/// the earlier kept (an arrival at both at once is impossible: the levels differ by b).
+std::optional<GapEvent> first_gap_event_inside(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
+                                               double start_gap, int face, double half, double horizon);
 
 /// The gap witness's mode: e = θL − θm on the free segment.
 WitnessMode gap_witness_mode(const LinearSegment& free_segment, double time_unit);

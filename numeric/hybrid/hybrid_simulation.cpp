@@ -254,6 +254,12 @@ HybridState step_start(const Parameters& p, double step) {
   return contact_state_on_face(p, step >= 0 ? -1 : +1, p.theta_R - step, 0);
 }
 
+bool inside_backlash(const Parameters& p, const HybridState& s) {
+  const double half = p.backlash / 2, x = s.theta_L - s.theta_m;
+  const double slack = 1e-12 * std::max({half, std::fabs(s.theta_m), std::fabs(s.theta_L)});  // the rounding of x
+  return std::fabs(x) < half - slack;
+}
+
 HybridState rigid_start(const Parameters& p, const HybridState& start) {
   if (p.backlash > 0) return start;
   const double omega = start.dtheta_m == start.dtheta_L ? start.dtheta_m
@@ -269,7 +275,10 @@ namespace {
 // first certified gap event), joined by the impact law.
 class ClosedFormRun {
  public:
-  ClosedFormRun(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options)
+  /// `start_gap`: the gap x = θL − θm of a free start strictly inside the backlash, computed
+  /// before any shift of the angles (simulate); none for every other start.
+  ClosedFormRun(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options,
+                std::optional<double> start_gap)
       : evaluator_(evaluator),
         p_(evaluator.parameters()),
         o_(options),
@@ -282,7 +291,8 @@ class ClosedFormRun {
         cancellation_scale_(4096 * std::numeric_limits<double>::epsilon() * std::fabs(torque_.r(0)) *
                             std::max(1.0, std::fabs(p_.theta_R))),
         rigid_(p_.backlash <= 0),  // a rigid drive: contact for ever, no events
-        state_(rigid_ ? rigid_start(p_, start) : start) {
+        state_(rigid_ ? rigid_start(p_, start) : start),
+        start_gap_(rigid_ || start.in_contact ? std::nullopt : start_gap) {
     if (o_.track_extremes) {
       const double unit = servo_time_unit(p_);
       contact_velocity_.emplace(velocity_mode(contact_segment_, 1, unit));
@@ -357,6 +367,7 @@ class ClosedFormRun {
   const double cancellation_scale_;  // see torque_sample
   const bool rigid_;
   HybridState state_;
+  std::optional<double> start_gap_;  // the first flight's gap x(0) when it starts inside the backlash
   double t_ = 0;
   ImpactWindow impacts_;
   long separations_ = 0;
@@ -454,7 +465,10 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   const auto at = [&flight](double tau) { return flight.at(tau); };
   const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(p_, state_.dtheta_m))});
   const auto sample = [&flight](double tau) { return flight.gap_sample(tau); };
-  const auto event = detail::first_gap_event(gap_mode_, sample, -state_.face * p_.backlash, remaining, scale);
+  const auto event = start_gap_ ? detail::first_gap_event_inside(gap_mode_, sample, *start_gap_, state_.face,
+                                                                 p_.backlash / 2, remaining)
+                                : detail::first_gap_event(gap_mode_, sample, -state_.face * p_.backlash, remaining, scale);
+  start_gap_.reset();  // every later flight leaves a face
   if (o_.track_extremes) {
     const auto vector = [&flight](double tau) { return flight.vector(tau); };
     segment_extremes(p_, free_velocities_->data(), 2, vector, at, event ? event->crossing.t : remaining, result_.extremes);
@@ -483,7 +497,7 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
 // so the search has not resolved the gap from rounding (a flight of no length, which would
 // start a burst of events at one instant).  Said, never continued (docs/physics.md, leaving a face).
 std::optional<std::string> ClosedFormRun::unresolved_return(const detail::GapEvent& event) const {
-  if (event.kind != detail::GapEventKind::FaceLeft) return std::nullopt;
+  if (event.kind != detail::GapEventKind::FaceLeft || event.from_inside) return std::nullopt;
   const double resolution = CrossingOptions{}.min_interval * servo_time_unit(p_);
   if (event.crossing.t > event.departure + resolution) return std::nullopt;
   char text[256];
@@ -528,8 +542,8 @@ std::optional<SimulationStatus> ClosedFormRun::impact(const detail::GapEvent& ev
 }
 
 SimulationResult simulate_as_given(const ValidatedEvaluator& evaluator, const HybridState& start,
-                                   const SimulationOptions& options) {
-  return ClosedFormRun(evaluator, start, options).run();
+                                   const SimulationOptions& options, std::optional<double> start_gap) {
+  return ClosedFormRun(evaluator, start, options, start_gap).run();
 }
 
 void shift_state(HybridState& s, double offset) {
@@ -543,8 +557,11 @@ void shift_state(HybridState& s, double offset) {
 // shifted by −θR on the way in and by +θR on the way out, so the gap θL − θm keeps its digits
 // whatever θR is.  A generated case evaluator (θR folded in) runs as given.
 SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options) {
+  const std::optional<double> start_gap = !start.in_contact && inside_backlash(evaluator.parameters(), start)
+                                              ? std::optional<double>(start.theta_L - start.theta_m)
+                                              : std::nullopt;
   const std::optional<ValidatedEvaluator> centred = in_error_coordinates(evaluator);
-  if (!centred) return simulate_as_given(evaluator, start, options);
+  if (!centred) return simulate_as_given(evaluator, start, options, start_gap);
   const double R = evaluator.parameters().theta_R;
   HybridState from = start;
   shift_state(from, -R);
@@ -568,7 +585,7 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
       shift_sample(moved);
       options.sample_sink(moved);
     };
-  SimulationResult r = simulate_as_given(*centred, from, shifted);
+  SimulationResult r = simulate_as_given(*centred, from, shifted, start_gap);
   for (SimulationEvent& e : r.events) {
     e.theta_o += R;
     shift_state(e.after, R);

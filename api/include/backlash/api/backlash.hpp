@@ -223,8 +223,9 @@ struct FreeFlightStart {
 /// `simulate --from`: any state of the hybrid system as a start (docs/physics.md: the gap
 /// x = θL − θm is centred, the faces are x = ±b/2): both shafts' angles [rad] and velocities
 /// [rad/s], in contact (on the face x = ±b/2, both shafts at one velocity; with a compliant mesh,
-/// the mesh engaged: |x| >= b/2) or in free flight leaving a face (x = ±b/2, the gap not
-/// closing beyond it; the nominal model with both shafts at one velocity: the drive not
+/// the mesh engaged: |x| >= b/2) or in free flight: strictly inside the backlash (|x| < b/2, any
+/// velocities; the first event is the gap's arrival at a face) or leaving a face (x = ±b/2, the
+/// gap not closing beyond it; the nominal model with both shafts at one velocity: the drive not
 /// pressing them together — a flight that would end at once).  Model::simulate_from_state
 /// checks it and runs the model from it.
 struct StartState {

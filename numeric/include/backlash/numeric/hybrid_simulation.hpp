@@ -191,6 +191,15 @@ HybridState step_start(const Parameters& p, double step);
 /// the impact law (eq. 24) when they differ.  Other states are returned unchanged.
 HybridState rigid_start(const Parameters& p, const HybridState& start);
 
+/// True for a free state strictly inside the backlash: |x| < b/2 for the gap x = θL − θm beyond
+/// its rounding 1e-12·max(b/2, |θm|, |θL|) (a state within it is on the face x = ±b/2).
+bool inside_backlash(const Parameters& p, const HybridState& s);
+
+/// The closed-form run from `start`.  A free start leaves its face σ (the face last left), or —
+/// inside_backlash — starts strictly inside: its first flight ends at the first arrival of the gap
+/// at either face, found by the same certified search as a flight from a face (docs/physics.md,
+/// "Gap, faces, events"): a recontact on σ (for a start inside: the nearer face, x > 0: +b/2),
+/// a recombination on −σ.
 SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options);
 SimulationResult simulate_step(const ValidatedEvaluator& evaluator, double step, const SimulationOptions& options);
 
