@@ -14,7 +14,7 @@ required_packages=(
   libceres-dev libmatio-dev
   libhdf5-dev libopenmpi-dev openmpi-bin libboost-mpi-dev
   texlive-latex-base texlive-latex-recommended texlive-fonts-recommended poppler-utils
-  python3-sympy python3-scipy python3-numpy python3-pytest python3-dev pybind11-dev
+  python3-sympy python3-mpmath python3-scipy python3-numpy python3-pytest python3-dev pybind11-dev
   emscripten nodejs chromium
 )
 
