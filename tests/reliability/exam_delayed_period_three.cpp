@@ -6,6 +6,9 @@
 // τ ≈ 0.7525 s, a period-3 window τ ∈ [0.7175, 0.7275] (multiplier smallest, ~0.03, at 0.725) and
 // no settling cycle in between.  The search's answer is checked against the independent
 // simulator (Boost.Odeint, numeric/reference_simulators) run from the step for 60 periods.
+// On the code before the period-k search (0496652^) the answer was the issue's: `none`, "no
+// stable cycle: the oscillation did not settle within the simulated cycles; the backlash is
+// outside the loop, so the system settles with a steady-state error".
 #include "backlash/model/case_spec.hpp"
 #include "backlash/numeric/effects.hpp"
 #include "backlash/numeric/effects_limit_cycle.hpp"
