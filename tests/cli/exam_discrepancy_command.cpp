@@ -226,17 +226,23 @@ TEST(DiscrepancyCommand, exam_TheReadmeExamplesRunAndSayWhatTheReadmeSays) {
   std::vector<std::string> commands;
   for (std::string line; std::getline(readme, line);)
     if (line.rfind("build/bin/backlash discrepancy", 0) == 0) commands.push_back(line);
-  ASSERT_EQ(commands.size(), 2u) << "the README has " << commands.size() << " discrepancy examples instead of 2";
+  ASSERT_EQ(commands.size(), 3u) << "the README has " << commands.size() << " discrepancy examples instead of 3";
   Folder folder;
   int k = 0;
   for (std::string command : commands) {
     SCOPED_TRACE(command);
     const std::size_t out = command.find(" --out ");
-    ASSERT_NE(out, std::string::npos);
-    command = command.substr(std::string("build/bin/backlash ").size(), out - std::string("build/bin/backlash ").size()) +
-              " --out " + (folder / ("out" + std::to_string(k++))).string();
+    const std::size_t end = out == std::string::npos ? command.size() : out;
+    command = command.substr(std::string("build/bin/backlash ").size(), end - std::string("build/bin/backlash ").size()) +
+              " --no-progress --out " + (folder / ("out" + std::to_string(k++))).string();
     const CommandRun r = run_shell("cd " + std::string(BACKLASH_SOURCE_DIR) + " && " + BACKLASH_CLI + " " + command);
     ASSERT_EQ(r.exit_code, 0) << r.err;
+    if (command.find("heavier_load") != std::string::npos) {  // a wrong nominal number, not an effect
+      EXPECT_NE(r.out.find(": parameters_corrected ("), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find("load.J          0.5 -> 0.574989 ± 1.1e-05  (x1.15)"), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find("(128.44 and 0.99 noise sigmas)"), std::string::npos) << r.out;
+      continue;
+    }
     EXPECT_NE(r.out.find("effect_found"), std::string::npos) << r.out;
     if (command.find("hidden_friction") != std::string::npos) {
       EXPECT_NE(r.out.find("coulomb_load    torque = 0.0200002"), std::string::npos) << r.out;

@@ -291,7 +291,7 @@ TEST_F(CaseFileVariants, BadEffectValuesNameLineAndKey) {
 TEST_F(CaseFileVariants, UnknownEffectIsRefusedWithTheVocabulary) {
   expect_rejected(with_effects({"coulomb_load = 0.1", "stiction = 0.2"}), 20, "effects.stiction",
                   "unknown key (allowed: coulomb_motor, coulomb_load, restitution, saturation, compliance, delay, "
-                  "torque_offset)");
+                  "torque_offset, stribeck_motor, stribeck_load)");
   expect_rejected(with_effects({"compliance = { stiffness = 10, damping = 1, mass = 2 }"}), 19,
                   "effects.compliance.mass", "unknown key (allowed: stiffness, damping)");
 }
