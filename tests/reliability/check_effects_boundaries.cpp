@@ -167,7 +167,11 @@ bool finite_result(const api::Simulation& run, const api::Cycle& cycle) {
 
 /// The run of the child: the case, the model, simulate and limit_cycle.
 [[noreturn]] void child(const std::string& text, int pipe_end) {
-  ::alarm(kSecondsPerRun);
+  // The limit is CPU time (a hang computes), so a loaded machine does not make a slow answer
+  // look like a hang; the wall-clock alarm, five times longer, only catches a run that waits.
+  const rlimit cpu{kSecondsPerRun, kSecondsPerRun};
+  ::setrlimit(RLIMIT_CPU, &cpu);
+  ::alarm(5 * kSecondsPerRun);
   const rlimit memory{kAddressSpace, kAddressSpace};
   ::setrlimit(RLIMIT_AS, &memory);
   try {
@@ -204,8 +208,9 @@ Outcome run_in_child(const std::string& text) {
   ::waitpid(pid, &status, 0);
   out.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   if (WIFSIGNALED(status))
-    out.line = WTERMSIG(status) == SIGALRM ? "no answer within " + std::to_string(kSecondsPerRun) + " s (a hang)"
-                                           : std::string("killed by signal ") + ::strsignal(WTERMSIG(status));
+    out.line = WTERMSIG(status) == SIGXCPU ? "no answer within " + std::to_string(kSecondsPerRun) + " s of CPU (a hang)"
+               : WTERMSIG(status) == SIGALRM ? "no answer within " + std::to_string(5 * kSecondsPerRun) + " s (a wait)"
+                                             : std::string("killed by signal ") + ::strsignal(WTERMSIG(status));
   return out;
 }
 
