@@ -253,9 +253,12 @@ TEST(Item13_Litter, FullDiskLeavesNothing) {
     std::ofstream fill(disk / "fill", std::ios::binary);
     fill << std::string(64 * 1024, 'x');  // more than fits: the disk is full
   }
-  // (report and discrepancy stage through the same StagedDirectory as the report test above; they are slow.)
-  for (const auto& command : std::vector<std::vector<std::string>>{{"codegen", "V", "--out", "cg"},
-                                                                   {"sweep", "fig31", "--points", "3", "--no-progress", "--out", "s.csv"}}) {
+  // (report stages through the same StagedDirectory as discrepancy and the report test above; it is slow.)
+  const std::string record = std::string(BACKLASH_SOURCE_DIR) + "/examples/case_V_with_hidden_friction.csv";
+  for (const auto& command : std::vector<std::vector<std::string>>{
+           {"codegen", "V", "--out", "cg"},
+           {"sweep", "fig31", "--points", "3", "--no-progress", "--out", "s.csv"},
+           {"discrepancy", "--model", "V", "--step", "0.62", "--data", record, "--no-progress", "--out", "d"}}) {
     const CliRun r = run(command, disk);
     SCOPED_TRACE(command.front());
     expect_one_line_error(r, 1, "cannot");
