@@ -583,8 +583,11 @@ std::string Cycle::text() const {
   const std::string kind = cycle.period_count > 1 ? "period-" + std::to_string(cycle.period_count) + " cycle" : "limit cycle";
   appendf(out, "%s: %s %s (%s; effects: %s)\n", case_id.c_str(), cycle.stable ? "stable" : "unstable", kind.c_str(),
           cycle.method.c_str(), effects.describe().c_str());
-  appendf(out, "  separation velocity  %.12f\n  multiplier (P')      %.9f\n  period               %.9f\n",
-          cycle.separation_velocity, cycle.multiplier, cycle.period);
+  if (std::isfinite(cycle.separation_velocity))
+    appendf(out, "  separation velocity  %.12f\n", cycle.separation_velocity);
+  else  // the bodies part only at impacts (restitution), never at a separation event
+    appendf(out, "  separation velocity  none (the bodies part only by bouncing at impacts)\n");
+  appendf(out, "  multiplier (P')      %.9f\n  period               %.9f\n", cycle.multiplier, cycle.period);
   appendf(out, "  amplitude |θo−θR|    %.9f\n  peak-to-peak θo      %.9f\n  peak-to-peak θm, θL  %.9f, %.9f\n",
           cycle.amplitude, cycle.peak_to_peak, cycle.peak_to_peak_motor, cycle.peak_to_peak_load);
   if (!effects.any())

@@ -266,6 +266,21 @@ TEST(Item13_Litter, FullDiskLeavesNothing) {
   }
 }
 
+// A cycle whose bodies part only by bouncing (restitution, with a delay: the period-3 case of
+// exam_delayed_period_three) has no separation velocity: the text says so, never "nan".
+TEST(Item16_Texts, CycleWithoutSeparationSaysSoInsteadOfNan) {
+  const fs::path folder = fresh_folder("bouncing_cycle");
+  std::ofstream(folder / "bouncing.toml") << slurp(fs::path(BACKLASH_SOURCE_DIR) / "cases" / "I.toml")
+                                          << "\n[effects]\ndelay = 0.725\nrestitution = 0.5\n";
+  const CliRun text = run({"limit-cycle", "bouncing.toml"}, folder);
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("period-3 cycle"), std::string::npos) << text.out;
+  EXPECT_EQ(text.out.find("nan"), std::string::npos) << "returned " << text.out << " with a nan";
+  EXPECT_NE(text.out.find("separation velocity  none (the bodies part only by bouncing"), std::string::npos) << text.out;
+  const CliRun json = run({"limit-cycle", "bouncing.toml", "--json"}, folder);
+  EXPECT_NE(json.out.find("\"separation_velocity\": null"), std::string::npos) << json.out;
+}
+
 // ---------------------------------------------------------------- item 14: one map per --out
 
 TEST(Item14_MapLock, SecondMapOnTheSameOutIsRefusedInOneLine) {
