@@ -37,7 +37,11 @@ namespace {
 using namespace backlash;
 
 constexpr double kStep = 0.62;   // case V's experiment
+#ifdef BACKLASH_ITEMS_SANITIZED
+constexpr rlim_t kSeconds = 120;  // as the boundaries test under the sanitizers
+#else
 constexpr rlim_t kSeconds = 20;  // CPU seconds per search: the boundaries test's limit per run
+#endif
 
 const numeric::ValidatedEvaluator& case_v() {
   static const numeric::ValidationResult v = numeric::validate(numeric::case_evaluator(model::load_case("V")));
