@@ -132,16 +132,24 @@ void check_sampling(double sample_interval, double t_end) {
   }
 }
 
-/// A simulation's request checked and its options made; the result is still to be computed.
-Simulation prepared(const Model& m, const SimulationRequest& request, numeric::SimulationOptions& options) {
-  const model::CaseSpec& spec = m.source().spec();
+/// A simulation of `m` to `t_end`, its sampling checked, with the model's case, parameters and
+/// effects; its start and its result are still to come.
+Simulation simulation_of(const Model& m, double t_end, double sample_interval) {
+  check_sampling(sample_interval, t_end);
   Simulation out;
-  out.step = requested_step(spec, request.step);
-  out.t_end = requested_t_end(spec, request.t_end);
-  check_sampling(request.sample_interval, out.t_end);
+  out.t_end = t_end;
   out.case_id = m.id();
   out.parameters = m.evaluator().parameters();
   out.effects = m.effect_model().effects();
+  return out;
+}
+
+/// A simulation's request checked and its options made; the result is still to be computed.
+Simulation prepared(const Model& m, const SimulationRequest& request, numeric::SimulationOptions& options) {
+  const model::CaseSpec& spec = m.source().spec();
+  const double step = requested_step(spec, request.step);
+  Simulation out = simulation_of(m, requested_t_end(spec, request.t_end), request.sample_interval);
+  out.step = step;
   // A step whose motion double precision cannot resolve against the backlash is refused
   // before any work (numeric/scales.hpp): an answer there would be rounding noise.
   const std::string what = request.step ? "the step " + detail::number_text(out.step) : "the step of the case file";
@@ -284,12 +292,7 @@ numeric::HybridState admitted_start(const numeric::Parameters& p, const numeric:
 Simulation prepared_from(const Model& m, const StartState& start, const SimulationRequest& request,
                          numeric::SimulationOptions& options) {
   if (request.step) throw BadInput("step", "not with a start state (--from): the run starts from that state");
-  Simulation out;
-  out.t_end = requested_t_end(m.source().spec(), request.t_end);
-  check_sampling(request.sample_interval, out.t_end);
-  out.case_id = m.id();
-  out.parameters = m.evaluator().parameters();
-  out.effects = m.effect_model().effects();
+  Simulation out = simulation_of(m, requested_t_end(m.source().spec(), request.t_end), request.sample_interval);
   out.start = admitted_start(out.parameters, out.effects, start);
   if (const auto problem = numeric::time_resolution_problem(out.parameters, out.effects, out.t_end))
     throw BadInput("t_end", *problem);
@@ -348,12 +351,7 @@ Simulation Model::simulate_from(const FreeFlightStart& start, double t_end, doub
   if (!std::isfinite(start.theta_o)) throw BadInput("theta_o", "not finite, got " + detail::number_text(start.theta_o));
   if (!std::isfinite(start.dtheta_o)) throw BadInput("dtheta_o", "not finite, got " + detail::number_text(start.dtheta_o));
   if (!std::isfinite(t_end) || t_end <= 0) throw BadInput("t_end", "must be > 0, got " + detail::number_text(t_end));
-  check_sampling(sample_interval, t_end);
-  Simulation out;
-  out.case_id = id();
-  out.t_end = t_end;
-  out.parameters = evaluator().parameters();
-  out.effects = effect_model().effects();
+  Simulation out = simulation_of(*this, t_end, sample_interval);
   if (const auto problem = numeric::time_resolution_problem(out.parameters, out.effects, t_end))
     throw BadInput("t_end", *problem);
   numeric::HybridState state = numeric::state_on_face(out.parameters, start.face, start.theta_o, start.dtheta_o, false);
