@@ -92,21 +92,33 @@ double milliseconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-/// A run's samples as columns t, θo, θ̇o, θm, θL (compact for the page).
-json sample_columns(const std::vector<numeric::TrajectorySample>& samples) {
-  json t = json::array(), o = json::array(), v = json::array(), m = json::array(), L = json::array();
-  for (const numeric::TrajectorySample& s : samples) {
-    t.push_back(s.t), o.push_back(s.theta_o), v.push_back(s.dtheta_o), m.push_back(s.theta_m), L.push_back(s.theta_L);
+/// The samples of the last runs, by name ("run": the last trajectory or step response,
+/// "orbit": the limit cycle's), as five columns one after the other — t, θo, θ̇o, θm, θL, each
+/// `count` long — that the page reads as typed arrays straight from the module's memory
+/// (samples(NAME)), not as JSON text: a frame draws several runs of ~800 samples each.
+std::vector<double>& sample_buffer(const std::string& name) {
+  static std::vector<double> run, orbit;
+  return name == "orbit" ? orbit : run;
+}
+void keep_samples(const std::string& name, const std::vector<numeric::TrajectorySample>& samples) {
+  std::vector<double>& out = sample_buffer(name);
+  const std::size_t n = samples.size();
+  out.resize(5 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const numeric::TrajectorySample& s = samples[i];
+    out[i] = s.t, out[n + i] = s.theta_o, out[2 * n + i] = s.dtheta_o, out[3 * n + i] = s.theta_m, out[4 * n + i] = s.theta_L;
   }
-  return {{"t", t}, {"theta_o", o}, {"dtheta_o", v}, {"theta_m", m}, {"theta_L", L}};
 }
 
-/// A run as the page needs it: the CLI's JSON document, the samples, the time it took.
+/// A run as the page needs it: the CLI's JSON document (spliced in as text: no parse and
+/// dump again), the time it took; its samples kept as "run".
 std::string run_json(const api::Simulation& run, double ms) {
-  json out{{"ok", true}, {"ms", ms}, {"samples", sample_columns(run.result.samples)}};
-  out["simulation"] = json::parse(run.json());
-  if (run.stopped_early()) out["stop_message"] = run.stop_message();
-  return out.dump();
+  keep_samples("run", run.result.samples);
+  json head{{"ok", true}, {"ms", ms}, {"count", run.result.samples.size()}};
+  if (run.stopped_early()) head["stop_message"] = run.stop_message();
+  std::string out = head.dump();
+  out.pop_back();  // the closing brace: the simulation document follows
+  return out + ",\"simulation\":" + run.json() + "}";
 }
 
 const api::Model& model() {
@@ -160,18 +172,23 @@ std::string portrait() {
     const auto t0 = std::chrono::steady_clock::now();
     const api::Model& m = model();
     const api::Cycle cycle = m.limit_cycle();
-    json out{{"ok", true}, {"cycle", json::parse(cycle.json())}};
+    json head{{"ok", true}, {"orbit", 0}};
     if (cycle.found() && std::isfinite(cycle.cycle.period) && cycle.cycle.period > 0) {
       const double v = cycle.cycle.separation_velocity;
       const numeric::Parameters& p = m.evaluator().parameters();
       const api::Simulation orbit =
           m.simulate_from({-1, p.theta_R + m.evaluator().cot_phi() * v, v}, cycle.cycle.period, cycle.cycle.period / 800);
-      out["orbit"] = sample_columns(orbit.result.samples);
+      keep_samples("orbit", orbit.result.samples);
+      head["orbit"] = orbit.result.samples.size();
     }
-    out["cycle_ms"] = milliseconds_since(t0);
-    out["trace"] = json::parse(m.trace().json());
-    out["ms"] = milliseconds_since(t0);
-    return out.dump();
+    head["cycle_ms"] = milliseconds_since(t0);
+    const auto t1 = std::chrono::steady_clock::now();
+    const std::string trace = m.trace().json();
+    head["trace_ms"] = milliseconds_since(t1);
+    head["ms"] = milliseconds_since(t0);
+    std::string out = head.dump();
+    out.pop_back();  // the CLI's documents follow as text
+    return out + ",\"cycle\":" + cycle.json() + ",\"trace\":" + trace + "}";
   });
 }
 
@@ -195,6 +212,28 @@ std::string step_response(double sample_interval) {
     const api::Simulation run = m.simulate({.sample_interval = sample_interval});
     return run_json(run, milliseconds_since(t0));
   });
+}
+
+/// The CSV of the run from (θo, θ̇o) as trajectory() computes it: `simulate --from θo,θ̇o
+/// [--flight] --t-end T --dt S --csv`, byte for byte (Simulation::csv, docs/design.md).
+std::string trajectory_csv(double theta_o, double dtheta_o, bool flight, double t_end, double sample_interval) {
+  return guarded([&] {
+    const api::Model& m = model();
+    const api::StartState start = api::start_state(m.evaluator().parameters(), {theta_o, dtheta_o}, !flight);
+    return m.simulate_from_state(start, {.t_end = t_end, .sample_interval = sample_interval}).csv();
+  });
+}
+
+/// The CSV of the step response: `simulate CASE --dt S --csv`, byte for byte.
+std::string step_csv(double sample_interval) {
+  return guarded([&] { return model().simulate({.sample_interval = sample_interval}).csv(); });
+}
+
+/// The columns kept by the last run (NAME "run") or limit cycle ("orbit"): a Float64Array
+/// view of the module's memory (valid until the next call into the module; the page copies it).
+emscripten::val samples(const std::string& name) {
+  const std::vector<double>& b = sample_buffer(name);
+  return emscripten::val(emscripten::typed_memory_view(b.size(), b.data()));
 }
 
 /// The limit cycle's peak-to-peak at `points` values of one parameter (its name in the
@@ -241,6 +280,9 @@ EMSCRIPTEN_BINDINGS(backlash_explorer) {
   emscripten::function("portrait", &portrait);
   emscripten::function("trajectory", &trajectory);
   emscripten::function("step_response", &step_response);
+  emscripten::function("trajectory_csv", &trajectory_csv);
+  emscripten::function("step_csv", &step_csv);
+  emscripten::function("samples", &samples);
   emscripten::function("slice", &slice);
   emscripten::function("effect_table", &effect_table);
 }

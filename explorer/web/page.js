@@ -6,7 +6,6 @@
 (async function () {
   const core = await createBacklashCore();
   const $ = (id) => document.getElementById(id);
-  const SVGNS = "http://www.w3.org/2000/svg";
   const PARAMS = [  // the case's parameters: Case::from_texts's names, slider ranges as factors of the case's value
     ["Jm", "motor inertia Jm"], ["Fm", "motor friction Fm"], ["JL", "load inertia JL"], ["FL", "load friction FL"],
     ["K", "loop gain K"], ["backlash", "backlash b"], ["reference", "reference θR"], ["step", "step A"], ["t_end", "t_end [s]"]];
@@ -30,7 +29,9 @@
     field.addEventListener("input", () => scheduleUpdate(name));
     // While a slider moves the portrait follows it; the live slice (25 limit cycles) follows on release.
     slider.addEventListener("input", () => { S.sliding = true; field.value = String(+Number(slider.value).toPrecision(6)); scheduleUpdate(name); });
-    slider.addEventListener("change", () => { S.sliding = false; if ($("slice_live").checked && S.loaded) computeSlice(); });
+    // On release the table of events (left alone while sliding: text is costly to lay out and paint
+    // every frame) and the live slice (25 limit cycles) follow.
+    slider.addEventListener("change", () => { S.sliding = false; if (S.loaded) { drawEvents(); if ($("slice_live").checked) computeSlice(); } });
   }
   for (const [name, label] of PARAMS) makeRow($("fields"), name, label);
   for (const e of EFFECTS) makeRow($("effects"), e.name, `${e.description} [${e.unit}]`);
@@ -103,21 +104,40 @@
 
   /// Loads the fields into the core, recomputes the portrait, the step response and the kept
   /// trajectories, and redraws; on bad input only the message changes (the picture is kept).
+  /// What the portrait and the trajectories depend on: every field but the step experiment's
+  /// (step, t_end) — with effects the step seeds the cycle search, so it counts there too.
+  function portraitKey(p) {
+    const effects = EFFECTS.some((e) => $("f_" + e.name).value.trim() !== "");
+    return JSON.stringify(effects ? p : p.filter(([n]) => !["step", "t_end", "experiment"].includes(n))) + "|" + $("traj_t_end").value;
+  }
+  /// The columns a run left in the core's memory (explorer_core.cpp, samples()): copied once
+  /// into a Float64Array, then t, θo, θ̇o, θm, θL as views of it — no JSON for the samples.
+  function columns(name, n) {
+    const a = core.samples(name).slice(), col = (k) => a.subarray(k * n, (k + 1) * n);
+    return { t: col(0), theta_o: col(1), dtheta_o: col(2), theta_m: col(3), theta_L: col(4) };
+  }
   function update() {
-    const t0 = performance.now();
-    const loaded = JSON.parse(core.load_case(JSON.stringify(pairs())));
+    const t0 = performance.now(), fields = pairs(), key = portraitKey(fields);
+    const loaded = JSON.parse(core.load_case(JSON.stringify(fields)));
     S.timings.load_ms = performance.now() - t0;
     clearErrors();
     if (!loaded.ok) return showError(loaded);
-    const portrait = JSON.parse(core.portrait());
+    // Only a change the portrait depends on recomputes it (and the trajectories): not the step's.
+    const same = key === S.portraitKey && S.portrait;
+    const portrait = same ? S.portrait : JSON.parse(core.portrait());
     if (!portrait.ok) return showError(portrait);
+    if (!same) portrait.orbit = portrait.orbit ? columns("orbit", portrait.orbit) : null;
+    const t1 = performance.now();
     // ~800 samples a run: the drawing's resolution (the events, exact, come apart from the samples).
     const tEnd = Number($("f_t_end").value) || 60;
-    const step = $("f_step").value.trim() !== "" ? JSON.parse(core.step_response(tEnd / 800)) : null;
+    const step = $("f_step").value.trim() !== "" ? sampled(JSON.parse(core.step_response(tEnd / 800))) : null;
     if (step && !step.ok) return showError(step);
-    S.loaded = loaded; S.portrait = portrait; S.step = step;
-    S.trajectories = S.trajectories.map((t) => runFrom(t.start)).filter((t) => t.ok);
+    if (step) step.dt = tEnd / 800;
+    S.loaded = loaded; S.portrait = portrait; S.step = step; S.portraitKey = key;
+    if (!same) S.trajectories = S.trajectories.map((t) => runFrom(t.start)).filter((t) => t.ok);
     S.timings.compute_ms = performance.now() - t0;
+    Object.assign(S.timings, { cycle_ms: same ? 0 : portrait.cycle_ms, trace_ms: same ? 0 : portrait.trace_ms,
+      portrait_ms: t1 - t0 - S.timings.load_ms, runs_ms: performance.now() - t1 });
     if (!S.view) S.view = defaultView();
     draw();
     if ($("slice_live").checked && !S.sliding) computeSlice();
@@ -126,10 +146,11 @@
     statusLine();
   }
 
+  function sampled(r) { if (r.ok) r.samples = columns("run", r.count); return r; }
   function runFrom(start) {
     const t_end = Number($("traj_t_end").value) || 60;
-    const r = JSON.parse(core.trajectory(start.theta_o, start.dtheta_o, start.flight, t_end, t_end / 800));
-    r.start = start;
+    const r = sampled(JSON.parse(core.trajectory(start.theta_o, start.dtheta_o, start.flight, t_end, t_end / 800)));
+    Object.assign(r, { start, t_end, dt: t_end / 800 });
     return r;
   }
 
@@ -145,8 +166,86 @@
     if (last) text += `last trajectory: ${last.simulation.status}, ${last.simulation.events.length} events, ${last.ms.toFixed(2)} ms` +
       (last.stop_message ? `\n${last.stop_message}` : "") + "\n";
     text += `redraw ${S.timings.update_ms?.toFixed(1)} ms: model ${S.timings.load_ms?.toFixed(1)} ms, portrait ` +
-      `${S.portrait.ms.toFixed(1)} ms, runs ${(S.timings.compute_ms - S.timings.load_ms - S.portrait.ms).toFixed(1)} ms, drawing ${S.timings.draw_ms?.toFixed(1)} ms`;
+      `${S.timings.portrait_ms?.toFixed(1)} ms, runs ${S.timings.runs_ms?.toFixed(1)} ms, drawing ${S.timings.draw_ms?.toFixed(1)} ms`;
     setStatus(text, false);
+  }
+
+  // ------------------------------------------------------------------ scenes: one drawing, two renderings
+  /// A drawing as a list of items in pixels — polylines (each one Path2D on the canvas), dots,
+  /// texts, rectangles — painted on a canvas (the live view: no DOM node per curve or point) or
+  /// written as SVG text (the download).  Items with `clip` are clipped to the scene's plot box.
+  function scene(w, h) { return { w, h, items: [], clip: { x: PAD.l, y: PAD.t, w: w - PAD.l - PAD.r, h: h - PAD.t - PAD.b } }; }
+  /// A curve through (xs[i], ys[i]) in data coordinates, mapped by toP; `pairs`: separate segments.
+  function curve(sc, xs, ys, toP, style) {
+    const n = xs.length, px = new Float32Array(n), py = new Float32Array(n);
+    for (let i = 0; i < n; i++) { const q = toP(xs[i], ys[i]); px[i] = q[0]; py[i] = q[1]; }
+    sc.items.push(Object.assign({ kind: "line", px, py, clip: true }, style));
+  }
+  function dots(sc, xs, ys, toP, style) {
+    const n = xs.length, px = new Float32Array(n), py = new Float32Array(n);
+    for (let i = 0; i < n; i++) { const q = toP(xs[i], ys[i]); px[i] = q[0]; py[i] = q[1]; }
+    sc.items.push(Object.assign({ kind: "dots", px, py, clip: true }, style));
+  }
+  const text = (sc, x, y, str, anchor) => sc.items.push({ kind: "text", x, y, str: String(str), anchor: anchor || "start" });
+
+  function tracePath(target, it) {
+    const { px, py } = it;
+    for (let i = 0; i < px.length; i++) {
+      if (it.pairs ? i % 2 === 0 : i === 0) target.moveTo(px[i], py[i]); else target.lineTo(px[i], py[i]);
+    }
+  }
+  function paint(canvas, sc) {
+    const dpr = window.devicePixelRatio || 1, W = Math.round(sc.w * dpr), H = Math.round(sc.h * dpr);
+    if (canvas.width !== W || canvas.height !== H) { canvas.width = W; canvas.height = H; }
+    paintOn(canvas.getContext("2d"), sc, dpr);
+  }
+  function paintOn(ctx, sc, scale) {
+    ctx.setTransform(scale, 0, 0, scale, 0, 0);
+    ctx.clearRect(0, 0, sc.w, sc.h);
+    ctx.fillStyle = "white"; ctx.fillRect(0, 0, sc.w, sc.h);
+    ctx.font = "11px system-ui, sans-serif";
+    for (const it of sc.items) {
+      ctx.save();
+      if (it.clip) { ctx.beginPath(); ctx.rect(sc.clip.x, sc.clip.y, sc.clip.w, sc.clip.h); ctx.clip(); }
+      if (it.kind === "rect") {
+        ctx.fillStyle = it.fill; ctx.fillRect(it.x, it.y, it.w, it.h); ctx.strokeStyle = it.stroke; ctx.strokeRect(it.x, it.y, it.w, it.h);
+      } else if (it.kind === "line") {
+        const p = new Path2D(); tracePath(p, it);
+        ctx.strokeStyle = it.stroke; ctx.lineWidth = it.width || 1; ctx.setLineDash(it.dash || []); ctx.stroke(p);
+      } else if (it.kind === "dots") {
+        const p = new Path2D();
+        for (let i = 0; i < it.px.length; i++) { p.moveTo(it.px[i] + it.r, it.py[i]); p.arc(it.px[i], it.py[i], it.r, 0, 2 * Math.PI); }
+        ctx.fillStyle = it.fill; ctx.fill(p);
+        if (it.stroke) { ctx.strokeStyle = it.stroke; ctx.lineWidth = 1; ctx.stroke(p); }
+      } else if (it.kind === "text") {
+        ctx.fillStyle = "#000"; ctx.textAlign = it.anchor === "middle" ? "center" : it.anchor === "end" ? "right" : "left"; ctx.fillText(it.str, it.x, it.y);
+      }
+      ctx.restore();
+    }
+  }
+  const xml = (s) => String(s).replace(/&/g, "&amp;").replace(/</g, "&lt;").replace(/"/g, "&quot;");
+  /// The scene as an SVG document (the figure download); `caption`: the legend, a line on top.
+  function svgOf(sc, caption) {
+    const f = (x) => (Math.round(x * 10) / 10).toString();
+    let out = `<svg xmlns="http://www.w3.org/2000/svg" width="${sc.w}" height="${sc.h + 16}" viewBox="0 -16 ${sc.w} ${sc.h + 16}">\n` +
+      `<defs><clipPath id="clip"><rect x="${sc.clip.x}" y="${sc.clip.y}" width="${sc.clip.w}" height="${sc.clip.h}"/></clipPath></defs>\n` +
+      `<rect x="0" y="-16" width="${sc.w}" height="${sc.h + 16}" fill="white"/>\n` +
+      `<text x="4" y="-4" font-family="sans-serif" font-size="11">${xml(caption)}</text>\n`;
+    for (const it of sc.items) {
+      const clip = it.clip ? ` clip-path="url(#clip)"` : "", cls = it.cls ? ` class="${it.cls}"` : "";
+      if (it.kind === "rect") out += `<rect x="${it.x}" y="${it.y}" width="${it.w}" height="${it.h}" fill="${it.fill}" stroke="${it.stroke}"/>\n`;
+      else if (it.kind === "line") {
+        let d = "";
+        for (let i = 0; i < it.px.length; i++) d += ((it.pairs ? i % 2 === 0 : i === 0) ? "M" : "L") + f(it.px[i]) + " " + f(it.py[i]);
+        out += `<path${cls} d="${d}" fill="none" stroke="${it.stroke}" stroke-width="${it.width || 1}"` +
+          (it.dash ? ` stroke-dasharray="${it.dash.join(" ")}"` : "") + `${clip}/>\n`;
+      } else if (it.kind === "dots") {
+        for (let i = 0; i < it.px.length; i++)
+          out += `<circle${cls} cx="${f(it.px[i])}" cy="${f(it.py[i])}" r="${it.r}" fill="${it.fill}"${it.stroke ? ` stroke="${it.stroke}"` : ""}${clip}/>\n`;
+      } else if (it.kind === "text")
+        out += `<text x="${f(it.x)}" y="${f(it.y)}" text-anchor="${it.anchor}" font-family="sans-serif" font-size="11">${xml(it.str)}</text>\n`;
+    }
+    return out + "</svg>\n";
   }
 
   // ------------------------------------------------------------------ the phase plane
@@ -165,28 +264,15 @@
   function measureBox() { const r = $("plane").getBoundingClientRect(); planeBox = { w: r.width, h: r.height, left: r.left, top: r.top }; return planeBox; }
   function box() { return planeBox || measureBox(); }
   const PAD = { l: 52, r: 10, t: 10, b: 30 };
-  function toPixel(x, y) {
-    const { w, h } = box(), v = S.view;
-    return [PAD.l + (x - v.x0) / (v.x1 - v.x0) * (w - PAD.l - PAD.r), h - PAD.b - (y - v.y0) / (v.y1 - v.y0) * (h - PAD.t - PAD.b)];
-  }
+  /// The map of a view v onto a w × h box (data → pixels), and back.
+  const mapping = (v, w, h) => (x, y) => [PAD.l + (x - v.x0) / (v.x1 - v.x0) * (w - PAD.l - PAD.r), h - PAD.b - (y - v.y0) / (v.y1 - v.y0) * (h - PAD.t - PAD.b)];
+  function toPixel(x, y) { const { w, h } = box(); return mapping(S.view, w, h)(x, y); }
   function fromPixel(px, py) {
     const { w, h } = box(), v = S.view;
     return [v.x0 + (px - PAD.l) / (w - PAD.l - PAD.r) * (v.x1 - v.x0), v.y0 + (h - PAD.b - py) / (h - PAD.t - PAD.b) * (v.y1 - v.y0)];
   }
   S.toClient = (x, y) => { const b = measureBox(), [px, py] = toPixel(x, y); return [b.left + px, b.top + py]; };
 
-  function el(parent, name, attrs, text) {
-    const e = document.createElementNS(SVGNS, name);
-    for (const k in attrs) e.setAttribute(k, attrs[k]);
-    if (text !== undefined) e.textContent = text;
-    parent.appendChild(e);
-    return e;
-  }
-  function path(parent, xs, ys, attrs) {
-    let d = "";
-    for (let i = 0; i < xs.length; i++) { const [px, py] = toPixel(xs[i], ys[i]); d += (i ? "L" : "M") + px.toFixed(1) + " " + py.toFixed(1); }
-    return el(parent, "path", Object.assign({ d, fill: "none" }, attrs));
-  }
   function ticks(a, b, n) {
     const step0 = (b - a) / n, mag = Math.pow(10, Math.floor(Math.log10(step0)));
     const step = [1, 2, 5, 10].map((m) => m * mag).find((s) => s >= step0);
@@ -194,60 +280,65 @@
     for (let t = Math.ceil(a / step) * step; t <= b; t += step) out.push(Math.abs(t) < step * 1e-9 ? 0 : t);
     return out;
   }
-  function axes(g, w, h, v, xlabel, ylabel, toP) {
-    el(g, "rect", { x: PAD.l, y: PAD.t, width: w - PAD.l - PAD.r, height: h - PAD.t - PAD.b, fill: "white", stroke: "#999" });
-    for (const t of ticks(v.x0, v.x1, 8)) { const [px] = toP(t, v.y0); el(g, "line", { x1: px, x2: px, y1: PAD.t, y2: h - PAD.b, stroke: "#eee" }); el(g, "text", { x: px, y: h - PAD.b + 13, "text-anchor": "middle" }, +t.toPrecision(4)); }
-    for (const t of ticks(v.y0, v.y1, 6)) { const [, py] = toP(v.x0, t); el(g, "line", { x1: PAD.l, x2: w - PAD.r, y1: py, y2: py, stroke: "#eee" }); el(g, "text", { x: PAD.l - 4, y: py + 4, "text-anchor": "end" }, +t.toPrecision(4)); }
-    el(g, "text", { x: w - PAD.r - 4, y: h - 4, "text-anchor": "end" }, xlabel);
-    el(g, "text", { x: 4, y: PAD.t + 10 }, ylabel);
+  function axes(sc, v, xlabel, ylabel, toP) {
+    const { w, h } = sc, gx = [], gy = [];
+    sc.items.push({ kind: "rect", x: PAD.l, y: PAD.t, w: w - PAD.l - PAD.r, h: h - PAD.t - PAD.b, fill: "white", stroke: "#999" });
+    for (const t of ticks(v.x0, v.x1, 8)) { const [px] = toP(t, v.y0); gx.push(px, px); gy.push(PAD.t, h - PAD.b); text(sc, px, h - PAD.b + 13, +t.toPrecision(4), "middle"); }
+    for (const t of ticks(v.y0, v.y1, 6)) { const [, py] = toP(v.x0, t); gx.push(PAD.l, w - PAD.r); gy.push(py, py); text(sc, PAD.l - 4, py + 4, +t.toPrecision(4), "end"); }
+    sc.items.push({ kind: "line", px: Float32Array.from(gx), py: Float32Array.from(gy), pairs: true, stroke: "#eee", cls: "grid" });
+    text(sc, w - PAD.r - 4, h - 4, xlabel, "end");
+    text(sc, 4, PAD.t + 10, ylabel);
   }
 
-  function draw() {
-    const t0 = performance.now();
-    const svg = $("plane"), { w, h } = measureBox(), v = S.view, p = S.loaded.parameters;
-    const timeBox = $("timeplot").getBoundingClientRect();  // measured before the drawing changes the layout
-    svg.innerHTML = "";
-    svg.setAttribute("viewBox", `0 0 ${w} ${h}`);
-    el(svg, "rect", { width: w, height: h, fill: "white" });
-    axes(svg, w, h, v, "θo [rad]", "θ̇o [rad/s]", toPixel);
-    const clip = el(el(svg, "defs", {}), "clipPath", { id: "clip" });
-    el(clip, "rect", { x: PAD.l, y: PAD.t, width: w - PAD.l - PAD.r, height: h - PAD.t - PAD.b });
-    const g = el(svg, "g", { "clip-path": "url(#clip)" });
+  /// The phase plane as a scene: isoclines, both halves of the separation line, the dividing
+  /// lines, the limit cycle, the record, the step response and the trajectories with their events.
+  function planeScene(w, h) {
+    const v = S.view, p = S.loaded.parameters, sc = scene(w, h), toP = mapping(v, w, h);
+    axes(sc, v, "θo [rad]", "θ̇o [rad/s]", toP);
     const R = p.theta_R, Y = [v.y0 - (v.y1 - v.y0), v.y1 + (v.y1 - v.y0)];
     for (const iso of S.loaded.isoclines)  // θ̇o = slope·(θR − θo), from the core's table
-      path(g, [R - Y[0] / iso.slope, R - Y[1] / iso.slope], Y, { stroke: "#d0d0d0", "stroke-width": 1 });
+      curve(sc, [R - Y[0] / iso.slope, R - Y[1] / iso.slope], Y, toP, { stroke: "#d0d0d0", cls: "isocline" });
     const c = S.loaded.cot_phi;  // the separation line θo = θR + cot φ·θ̇o: its half leaving each face
-    path(g, [R, R + c * Y[1]], [0, Y[1]], { stroke: "#ff7f0e", "stroke-width": 1.6 });
-    path(g, [R, R + c * Y[0]], [0, Y[0]], { stroke: "#d62728", "stroke-width": 1.6, "stroke-dasharray": "6 3" });
-    drawDividingLines(g);
-    if (S.portrait.orbit) path(g, S.portrait.orbit.theta_o, S.portrait.orbit.dtheta_o, { stroke: "#e00", "stroke-width": 2.4 });
-    if (S.record) path(g, S.record.thetaForPlane, S.record.dtheta, { stroke: "#000", "stroke-width": 1, "stroke-dasharray": "2 2" });
-    if (S.step) drawRun(g, S.step, "#555", 1.2);
-    S.trajectories.forEach((t, i) => drawRun(g, t, COLORS[i % COLORS.length], 1.6));
-    el(g, "circle", { cx: toPixel(R, 0)[0], cy: toPixel(R, 0)[1], r: 3, fill: "#000" });
+    curve(sc, [R, R + c * Y[1]], [0, Y[1]], toP, { stroke: "#ff7f0e", width: 1.6, cls: "separation" });
+    curve(sc, [R, R + c * Y[0]], [0, Y[0]], toP, { stroke: "#d62728", width: 1.6, dash: [6, 3], cls: "separation" });
+    dividingLines(sc, toP);
+    if (S.portrait.orbit) curve(sc, S.portrait.orbit.theta_o, S.portrait.orbit.dtheta_o, toP, { stroke: "#e00", width: 2.4, cls: "limit-cycle" });
+    if (S.record) curve(sc, S.record.thetaForPlane, S.record.dtheta, toP, { stroke: "#000", dash: [2, 2], cls: "record" });
+    if (S.step) run(sc, S.step, "#555", 1.2, toP, "step");
+    S.trajectories.forEach((t, i) => run(sc, t, COLORS[i % COLORS.length], 1.6, toP, "trajectory"));
+    dots(sc, [R], [0], toP, { r: 3, fill: "#000" });
+    return sc;
+  }
+  function draw() {
+    const t0 = performance.now();
+    const { w, h } = measureBox(), timeBox = $("timeplot").getBoundingClientRect();  // measured before the drawing changes the layout
+    S.scene = planeScene(w, h);
+    paint($("plane"), S.scene);
     legend();
     drawTime(timeBox);
     drawEvents();
     S.timings.draw_ms = performance.now() - t0;
   }
-  function drawDividingLines(g) {  // trace: recombination (or recontact) states after the impact, per sign of θ̇m0
+  function dividingLines(sc, toP) {  // trace: recombination (or recontact) states after the impact, per sign of θ̇m0
     const pts = S.portrait.trace.points.filter((q) => q.theta_o !== null);
     const groups = {};
     for (const q of pts) (groups[(q.v0 > 0 ? "+" : "−") + q.status] ||= []).push(q);
     const styles = ["#6a3d9a", "#b15928", "#33a02c", "#a6cee3"];
     Object.keys(groups).sort().forEach((k, i) => {
       const q = groups[k].sort((a, b) => a.v0 - b.v0);
-      path(g, q.map((x) => x.theta_o), q.map((x) => x.dtheta_o), { stroke: styles[i % 4], "stroke-width": 1.3, "stroke-dasharray": "1 2", class: "dividing" });
+      curve(sc, q.map((x) => x.theta_o), q.map((x) => x.dtheta_o), toP, { stroke: styles[i % 4], width: 1.3, dash: [1, 2], cls: "dividing" });
     });
     S.dividingGroups = Object.keys(groups).sort();
   }
-  function drawRun(g, run, color, width) {
-    path(g, run.samples.theta_o, run.samples.dtheta_o, { stroke: color, "stroke-width": width });
-    for (const e of run.simulation.events) {
-      const [px, py] = toPixel(e.theta_o, e.dtheta_o);
-      el(g, "circle", { cx: px, cy: py, r: 2.6, fill: "white", stroke: color }).appendChild(document.createElementNS(SVGNS, "title")).textContent =
-        `${e.kind} t = ${e.t}`;
-    }
+  function run(sc, r, color, width, toP, cls) {
+    curve(sc, r.samples.theta_o, r.samples.dtheta_o, toP, { stroke: color, width, cls });
+    const ev = r.simulation.events;
+    dots(sc, ev.map((e) => e.theta_o), ev.map((e) => e.dtheta_o), toP, { r: 2.6, fill: "white", stroke: color, cls: "event" });
+  }
+  function legendText() {
+    const c = S.portrait.cycle;
+    return "separation line (leaving x = −b/2: solid, x = +b/2: dashed), dividing lines (dotted), isoclines (grey), step response (dark grey), " +
+      (c.status === "limit_cycle" ? `limit cycle (red, peak-to-peak ${c.peak_to_peak.toPrecision(6)})` : `no limit cycle: ${c.status} — ${c.reason}`);
   }
   function legend() {
     const c = S.portrait.cycle;
@@ -259,27 +350,30 @@
   }
 
   // ------------------------------------------------------------------ the time panel and the events
+  function range(arrays) {
+    let lo = Infinity, hi = -Infinity;
+    for (const a of arrays) for (let i = 0; i < a.length; i++) { if (a[i] < lo) lo = a[i]; if (a[i] > hi) hi = a[i]; }
+    return [lo, hi];
+  }
   function drawTime(r) {
-    const svg = $("timeplot"), w = r.width, h = r.height;
-    svg.innerHTML = "";
-    const run = S.trajectories[S.trajectories.length - 1] || S.step;
-    if (!run || w === 0) return;
-    const s = run.samples, all = s.theta_o.concat(s.theta_m, s.theta_L, S.record ? S.record.theta : []);
-    const v = { x0: 0, x1: Math.max(s.t[s.t.length - 1], 1e-9), y0: Math.min(...all), y1: Math.max(...all) };
-    if (v.y1 === v.y0) v.y1 = v.y0 + 1;
-    const toP = (x, y) => [PAD.l + (x - v.x0) / (v.x1 - v.x0) * (w - PAD.l - PAD.r), h - PAD.b - (y - v.y0) / (v.y1 - v.y0) * (h - PAD.t - PAD.b)];
-    axes(svg, w, h, v, "t [s]", "rad", toP);
-    const line = (xs, ys, color, dash) => {
-      let d = ""; for (let i = 0; i < xs.length; i++) { const [px, py] = toP(xs[i], ys[i]); d += (i ? "L" : "M") + px.toFixed(1) + " " + py.toFixed(1); }
-      el(svg, "path", { d, fill: "none", stroke: color, "stroke-width": 1.3, "stroke-dasharray": dash || "" });
-    };
-    line(s.t, s.theta_m, "#2ca02c"); line(s.t, s.theta_L, "#9467bd", "4 2"); line(s.t, s.theta_o, "#1f77b4");
-    if (S.record) line(S.record.t, S.record.theta, "#000", "2 2");
-    el(svg, "text", { x: PAD.l + 6, y: PAD.t + 12 }, "θo (blue), θm (green), θL (purple, dashed)" + (S.record ? ", record (black)" : ""));
+    const canvas = $("timeplot"), w = r.width, h = r.height;
+    const last = S.trajectories[S.trajectories.length - 1] || S.step;
+    if (!last || w === 0) return;
+    const s = last.samples, [y0, y1] = range([s.theta_o, s.theta_m, s.theta_L, S.record ? S.record.theta : []]);
+    const v = { x0: 0, x1: Math.max(s.t[s.t.length - 1], 1e-9), y0, y1: y1 === y0 ? y0 + 1 : y1 };
+    const sc = scene(w, h), toP = mapping(v, w, h);
+    axes(sc, v, "t [s]", "rad", toP);
+    curve(sc, s.t, s.theta_m, toP, { stroke: "#2ca02c", width: 1.3 });
+    curve(sc, s.t, s.theta_L, toP, { stroke: "#9467bd", width: 1.3, dash: [4, 2] });
+    curve(sc, s.t, s.theta_o, toP, { stroke: "#1f77b4", width: 1.3 });
+    if (S.record) curve(sc, S.record.t, S.record.theta, toP, { stroke: "#000", width: 1.3, dash: [2, 2], cls: "record" });
+    text(sc, PAD.l + 6, PAD.t + 12, "θo (blue), θm (green), θL (purple, dashed)" + (S.record ? ", record (black)" : ""));
+    S.timeScene = sc;
+    paint(canvas, sc);
   }
   function drawEvents() {
     const run = S.trajectories[S.trajectories.length - 1] || S.step;
-    if (!run || run === S.eventsShown) return;  // the table is rebuilt only for another run
+    if (!run || run === S.eventsShown || S.sliding) return;  // the table is rebuilt only for another run
     S.eventsShown = run;
     const sim = run.simulation;
     $("traj_info").textContent = S.trajectories.length ? `from θo = ${run.start.theta_o}, θ̇o = ${run.start.dtheta_o}` +
@@ -297,7 +391,7 @@
   plane.addEventListener("mousedown", (ev) => { drag = { x: ev.clientX, y: ev.clientY, view: { ...S.view }, moved: false }; });
   plane.addEventListener("mousemove", (ev) => {
     const b = measureBox(), [x, y] = fromPixel(ev.clientX - b.left, ev.clientY - b.top);
-    $("readout").textContent = `θo = ${x.toPrecision(6)}  θ̇o = ${y.toPrecision(6)}`;
+    $("readout").textContent = `θo = ${x.toPrecision(6)}  θ̇o = ${y.toPrecision(6)}` + nearEvent(ev.clientX - b.left, ev.clientY - b.top);
     if (!drag) return;
     const dx = ev.clientX - drag.x, dy = ev.clientY - drag.y;
     if (Math.abs(dx) + Math.abs(dy) > 4) drag.moved = true;
@@ -306,6 +400,14 @@
     S.view = { x0: drag.view.x0 - dx * sx, x1: drag.view.x1 - dx * sx, y0: drag.view.y0 + dy * sy, y1: drag.view.y1 + dy * sy };
     draw();
   });
+  function nearEvent(px, py) {  // the event marker under the pointer (within 5 px), as its tooltip was
+    for (const r of S.trajectories.concat(S.step ? [S.step] : []))
+      for (const e of r.simulation.events) {
+        const [ex, ey] = toPixel(e.theta_o, e.dtheta_o);
+        if (Math.abs(ex - px) < 5 && Math.abs(ey - py) < 5) return `  — ${e.kind} at t = ${e.t}`;
+      }
+    return "";
+  }
   plane.addEventListener("mouseup", (ev) => {
     const wasDrag = drag && drag.moved;
     drag = null;
@@ -350,19 +452,15 @@
     const r = JSON.parse(core.slice(name, from, to, 25));
     if (!r.ok) return;
     S.slice = r;
-    const svg = $("slice"), w = 300, h = 150;
-    svg.innerHTML = "";
+    const w = 300, h = 150, sc = scene(w, h);
     const ys = r.rows.filter((q) => q.peak_to_peak !== undefined).map((q) => q.peak_to_peak);
-    const v = { x0: Math.min(from, to), x1: Math.max(from, to), y0: 0, y1: ys.length ? Math.max(...ys) * 1.1 : 1 };
-    const toP = (x, y) => [PAD.l + (x - v.x0) / (v.x1 - v.x0) * (w - PAD.l - PAD.r), h - PAD.b - (y - v.y0) / (v.y1 - v.y0) * (h - PAD.t - PAD.b)];
-    axes(svg, w, h, v, name, "peak-to-peak", toP);
-    for (const q of r.rows) {
-      const [px, py] = toP(q.x, q.peak_to_peak ?? 0);
-      el(svg, "circle", { cx: px, cy: py, r: 2.5, fill: q.peak_to_peak !== undefined ? "#e00" : "#999" })
-        .appendChild(document.createElementNS(SVGNS, "title")).textContent = `${name} = ${q.x}: ${q.status}${q.reason ? " — " + q.reason : ""}`;
-    }
-    const [cx] = toP(value, 0);
-    el(svg, "line", { x1: cx, x2: cx, y1: PAD.t, y2: h - PAD.b, stroke: "#1f77b4", "stroke-dasharray": "3 2" });
+    const v = { x0: Math.min(from, to), x1: Math.max(from, to), y0: 0, y1: ys.length ? Math.max(...ys) * 1.1 : 1 }, toP = mapping(v, w, h);
+    axes(sc, v, name, "peak-to-peak", toP);
+    const found = r.rows.filter((q) => q.peak_to_peak !== undefined), none = r.rows.filter((q) => q.peak_to_peak === undefined);
+    dots(sc, found.map((q) => q.x), found.map((q) => q.peak_to_peak), toP, { r: 2.5, fill: "#e00" });
+    dots(sc, none.map((q) => q.x), none.map(() => 0), toP, { r: 2.5, fill: "#999" });
+    curve(sc, [value, value], [v.y0, v.y1], toP, { stroke: "#1f77b4", dash: [3, 2] });
+    paint($("slice"), sc);
   }
   $("slice_param").onchange = () => computeSlice();
   $("slice_from").onchange = $("slice_to").onchange = () => computeSlice();
@@ -373,49 +471,71 @@
     a.href = URL.createObjectURL(blob); a.download = name; a.click();
     setTimeout(() => URL.revokeObjectURL(a.href), 1000);
   }
-  const svgText = () => new XMLSerializer().serializeToString($("plane"));
+  /// The phase plane as drawn, as SVG (the scene written as text, its legend on top) and as PNG
+  /// (the scene painted at twice the size).
+  const svgText = () => svgOf(S.scene, legendText());
+  S.svgText = svgText;
   $("dl_svg").onclick = () => download("phase-plane.svg", new Blob([svgText()], { type: "image/svg+xml" }));
   $("dl_png").onclick = () => {
-    const { w, h } = box(), img = new Image(), url = URL.createObjectURL(new Blob([svgText()], { type: "image/svg+xml" }));
-    img.onload = () => {
-      const canvas = document.createElement("canvas"); canvas.width = w * 2; canvas.height = h * 2;
-      const ctx = canvas.getContext("2d"); ctx.scale(2, 2); ctx.drawImage(img, 0, 0, w, h);
-      canvas.toBlob((b) => download("phase-plane.png", b)); URL.revokeObjectURL(url);
-    };
-    img.src = url;
+    const canvas = document.createElement("canvas");
+    canvas.width = S.scene.w * 2; canvas.height = S.scene.h * 2;
+    paintOn(canvas.getContext("2d"), S.scene, 2);
+    canvas.toBlob((b) => download("phase-plane.png", b));
   };
-  $("dl_csv").onclick = () => {  // the columns of `simulate --csv` (mode: contact or free, from the events)
+  /// The last trajectory (else the step response) as `simulate --from … --csv` (`simulate CASE
+  /// --csv`) writes it, byte for byte: the core computes it again with the run's own request.
+  $("dl_csv").onclick = () => {
     const run = S.trajectories[S.trajectories.length - 1] || S.step;
     if (!run) return;
-    const s = run.samples;
-    let text = "t,theta_o,dtheta_o,theta_m,theta_L\n";
-    for (let i = 0; i < s.t.length; i++) text += `${s.t[i]},${s.theta_o[i]},${s.dtheta_o[i]},${s.theta_m[i]},${s.theta_L[i]}\n`;
+    const text = run.start ? core.trajectory_csv(run.start.theta_o, run.start.dtheta_o, run.start.flight, run.t_end, run.dt)
+      : core.step_csv(run.dt);
+    if (text.startsWith("{")) return showError(JSON.parse(text));
     download("trajectory.csv", new Blob([text], { type: "text/csv" }));
   };
-  $("dl_case").onclick = () => S.loaded && download((S.caseName || "case").replace(/\W+/g, "_") + ".toml",
-    new Blob([S.loaded.case_file], { type: "application/toml" }));
+  S.caseFileName = () => (S.caseName || "case").replace(/\W+/g, "_") + ".toml";
+  $("dl_case").onclick = () => S.loaded && download(S.caseFileName(), new Blob([S.loaded.case_file], { type: "application/toml" }));
 
-  /// A measured record (the project's CSV: header t,theta_out[,...]) overlaid on the time panel
-  /// and, with its differences, on the phase plane.  Reading a table is no physics.
+  /// A measured record (the project's CSV, docs/design.md "Measured data (CSV)": a header naming
+  /// the columns, t and theta_out required, t strictly increasing, every cell a finite number,
+  /// at least 10 rows) overlaid on the time panel and, with its differences, on the phase plane.
+  /// Reading a table is no physics.  A bad record: the first problem, "FILE:LINE: COLUMN:
+  /// problem", beside the drop zone; the picture is kept.
+  function recordProblem(text, name) {
+    const lines = text.replace(/^\uFEFF/, "").split(/\r?\n/);
+    while (lines.length && lines[lines.length - 1].trim() === "") lines.pop();
+    const header = (lines[0] ?? "").split(",").map((x) => x.trim());
+    for (const c of ["t", "theta_out"]) if (!header.includes(c)) return { message: `${name}:1: ${c}: missing column (the header is "${lines[0] ?? ""}")` };
+    const it = header.indexOf("t"), io = header.indexOf("theta_out"), t = [], theta = [];
+    for (let k = 1; k < lines.length; k++) {
+      const cells = lines[k].split(",");
+      if (cells.length !== header.length) return { message: `${name}:${k + 1}: the row has ${cells.length} cells, the header ${header.length}` };
+      for (const [i, col] of [[it, "t"], [io, "theta_out"]]) {
+        const cell = cells[i].trim();
+        if (!/^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/.test(cell) || !Number.isFinite(Number(cell)))
+          return { message: `${name}:${k + 1}: ${col}: not a finite number: "${cell}"` };
+      }
+      const a = Number(cells[it]), b = Number(cells[io]);
+      if (t.length && !(a > t[t.length - 1])) return { message: `${name}:${k + 1}: t: time ${a} is not after ${t[t.length - 1]}; t must be strictly increasing` };
+      t.push(a); theta.push(b);
+    }
+    if (t.length < 10) return { message: `${name}: too few samples: ${t.length} data rows, at least 10 required` };
+    return { t, theta };
+  }
   function loadRecord(text, name) {
-    const lines = text.split(/\r?\n/).filter((l) => l && !l.startsWith("#"));
-    const header = lines.shift().split(",").map((x) => x.trim());
-    const it = header.indexOf("t"), io = header.indexOf("theta_out");
-    if (it < 0 || io < 0) return setStatus(`${name}: no t and theta_out columns`, true);
-    const t = [], theta = [];
-    for (const l of lines) { const c = l.split(","); const a = Number(c[it]), b = Number(c[io]); if (Number.isFinite(a) && Number.isFinite(b)) { t.push(a); theta.push(b); } }
-    const dtheta = theta.map((x, i) => i + 1 < theta.length ? (theta[i + 1] - x) / (t[i + 1] - t[i]) : NaN).slice(0, -1);
+    const r = recordProblem(text, name);
+    $("e_record").textContent = r.message || "";
+    if (r.message) return setStatus(r.message + "\n(the last valid picture is kept)", true);
+    const { t, theta } = r;
+    const dtheta = theta.slice(0, -1).map((x, i) => (theta[i + 1] - x) / (t[i + 1] - t[i]));
     S.record = { name, t, theta, dtheta, thetaForPlane: theta.slice(0, -1) };
     draw();
     setStatus(`record ${name}: ${t.length} samples overlaid`, false);
   }
   S.loadRecord = loadRecord;
+  const readRecordFile = (f) => f && f.text().then((text) => loadRecord(text, f.name));
   document.body.addEventListener("dragover", (ev) => ev.preventDefault());
-  document.body.addEventListener("drop", (ev) => {
-    ev.preventDefault();
-    const f = ev.dataTransfer.files[0];
-    if (f) f.text().then((text) => loadRecord(text, f.name));
-  });
+  document.body.addEventListener("drop", (ev) => { ev.preventDefault(); readRecordFile(ev.dataTransfer.files[0]); });
+  $("record_file").addEventListener("change", () => readRecordFile($("record_file").files[0]));
   window.addEventListener("resize", () => S.loaded && draw());
 
   $("case").value = "V";

@@ -8,21 +8,24 @@
 // peak-to-peak shown equals `backlash limit-cycle V --json`'s, and the step response's events
 // `backlash simulate V --json`'s, to 1e-12; a scripted click on the phase plane starts the run
 // whose events equal `backlash simulate V --from θo,θ̇o` at the clicked state (contact and
-// flight); a bad value shows the inline error naming the field and keeps the drawing; a
-// screenshot of each thesis case is written to ARTIFACT_DIR.  Prints the measured times (a 60 s
-// trajectory, the redraw rate while a slider moves).  Exit 77 (ctest SKIP_RETURN_CODE) with the
+// flight); a bad value shows the inline error naming the field and keeps the drawing; the
+// downloads: the figure as SVG (well-formed, with its curves) and PNG (signature, size), the
+// trajectory's CSV (`simulate --from … --csv`'s bytes), the case file (`limit-cycle FILE --json`
+// gives the peak-to-peak the page shows); a measured record given to the page is overlaid, a
+// bad one gives the inline error and keeps the drawing; a screenshot of each thesis case is
+// written to ARTIFACT_DIR.  Prints the time of a 60 s trajectory (the redraw rate while a
+// slider moves: bench/explorer_redraw.sh).  Exit 77 (ctest SKIP_RETURN_CODE) with the
 // reason when there is no Chromium, or when the build makes no page ("not-built": no emcc, or a
 // sanitizer build); a page the build should have made and did not is a failure.
-import { spawn, execFileSync } from "node:child_process";
+import { execFileSync } from "node:child_process";
 import fs from "node:fs";
 import os from "node:os";
 import path from "node:path";
+import { findChromium, openBrowser } from "./devtools.mjs";
 
 const [page, cli, artifacts, built = "built"] = process.argv.slice(2);
 const SKIP = 77;
-const chromium = ["chromium", "chromium-browser", "google-chrome"].map((name) => {
-  try { return execFileSync("sh", ["-c", `command -v ${name}`]).toString().trim(); } catch { return ""; }
-}).find((p) => p);
+const chromium = findChromium();
 if (!chromium) { console.log("SKIP: no Chromium installed (apt-get install chromium; scripts/install-deps.sh)"); process.exit(SKIP); }
 if (built === "not-built") {
   console.log("SKIP: this build makes no explorer page (no emcc — apt-get install emscripten — or a sanitizer build)");
@@ -37,66 +40,16 @@ function check(what, ok, detail) {
   if (!ok) failures.push(what);
 }
 
-// ------------------------------------------------------------------ the DevTools pipe
-const profile = fs.mkdtempSync(path.join(os.tmpdir(), "explorer-chromium-"));
-const browser = spawn(chromium, ["--headless=new", "--no-sandbox", "--disable-gpu", "--remote-debugging-pipe",
-  "--no-first-run", "--no-default-browser-check", "--disable-extensions", "--disable-background-networking",
-  "--disable-component-update", "--disable-sync", "--metrics-recording-only", "--window-size=1400,900",
-  `--user-data-dir=${profile}`, "about:blank"], { stdio: ["ignore", "ignore", "pipe", "pipe", "pipe"] });
-let stderr = "";
-browser.stderr.on("data", (d) => { stderr += d; });
-const toBrowser = browser.stdio[3], fromBrowser = browser.stdio[4];
-let nextId = 1, buffer = "";
-const waiting = new Map(), listeners = [];
-fromBrowser.on("data", (chunk) => {
-  buffer += chunk.toString();
-  let end;
-  while ((end = buffer.indexOf("\0")) >= 0) {
-    const message = JSON.parse(buffer.slice(0, end));
-    buffer = buffer.slice(end + 1);
-    if (message.id && waiting.has(message.id)) {
-      const { resolve, reject, method } = waiting.get(message.id);
-      waiting.delete(message.id);
-      message.error ? reject(new Error(`${method}: ${message.error.message}`)) : resolve(message.result);
-    } else for (const l of listeners) l(message);
-  }
-});
-function send(method, params = {}, sessionId) {
-  const id = nextId++;
-  toBrowser.write(JSON.stringify({ id, method, params, ...(sessionId ? { sessionId } : {}) }) + "\0");
-  return new Promise((resolve, reject) => waiting.set(id, { resolve, reject, method }));
-}
-const watchdog = setTimeout(() => { console.log("FAIL: the browser test ran over 150 s\n" + stderr.slice(-2000)); browser.kill("SIGKILL"); process.exit(1); }, 150000);
-
-const { targetId } = await send("Target.createTarget", { url: "about:blank" });
-const { sessionId } = await send("Target.attachToTarget", { targetId, flatten: true });
-const cdp = (method, params) => send(method, params, sessionId);
+const b = await openBrowser(chromium);
+const watchdog = setTimeout(() => { console.log("FAIL: the browser test ran over 150 s\n" + b.stderr().slice(-2000)); b.close(); process.exit(1); }, 150000);
+const { cdp, evaluate, waitFor, frame } = b;
 const requests = [];
-listeners.push((m) => { if (m.sessionId === sessionId && m.method === "Network.requestWillBeSent") requests.push(m.params.request.url); });
-const consoleErrors = [];
-listeners.push((m) => {
-  if (m.sessionId === sessionId && m.method === "Runtime.exceptionThrown") consoleErrors.push(m.params.exceptionDetails.text + " " + (m.params.exceptionDetails.exception?.description || ""));
-});
+b.listeners.push((m) => { if (m.sessionId === b.sessionId && m.method === "Network.requestWillBeSent") requests.push(m.params.request.url); });
 await cdp("Network.enable");
-await cdp("Runtime.enable");
-await cdp("Page.enable");
-await cdp("Emulation.setDeviceMetricsOverride", { width: 1400, height: 900, deviceScaleFactor: 1, mobile: false });
-
-async function evaluate(expression) {
-  const r = await cdp("Runtime.evaluate", { expression, returnByValue: true, awaitPromise: true });
-  if (r.exceptionDetails) throw new Error(`${expression}: ${r.exceptionDetails.exception?.description || r.exceptionDetails.text}`);
-  return r.result.value;
-}
-async function waitFor(expression, seconds = 30) {
-  const until = Date.now() + seconds * 1000;
-  while (Date.now() < until) {
-    if (await evaluate(expression)) return true;
-    await new Promise((r) => setTimeout(r, 50));
-  }
-  throw new Error(`timed out waiting for ${expression}; page errors: ${consoleErrors.join("; ")}`);
-}
-const frame = () => evaluate("new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)))");
+const consoleErrors = b.pageErrors;
 const backlash = (...args) => JSON.parse(execFileSync(cli, args).toString());
+const downloads = fs.mkdtempSync(path.join(os.tmpdir(), "explorer-downloads-"));
+const pixels = () => evaluate(`document.getElementById("plane").toDataURL()`);
 
 function sameEvents(what, page, expected, count) {
   const n = count ?? expected.length;
@@ -107,6 +60,17 @@ function sameEvents(what, page, expected, count) {
   }
   check(what, kinds && page.length >= n && (count !== undefined || page.length === expected.length) && worst <= 1e-12,
     `${n} events, kinds ${kinds ? "equal" : "differ"}, largest difference ${worst}`);
+}
+
+/// Clicks the page's download button and returns the file it saved (Browser.setDownloadBehavior).
+async function downloaded(button, name) {
+  const file = path.join(downloads, name);
+  fs.rmSync(file, { force: true });
+  await evaluate(`document.getElementById("${button}").click()`);
+  const until = Date.now() + 10000;
+  while (Date.now() < until && !fs.existsSync(file)) await new Promise((r) => setTimeout(r, 50));
+  await new Promise((r) => setTimeout(r, 100));  // the file is renamed into place when complete
+  return fs.existsSync(file) ? fs.readFileSync(file) : null;
 }
 
 // ------------------------------------------------------------------ the checks
@@ -152,39 +116,87 @@ try {
 
   // a bad value: the inline error naming the field, the drawing kept
   for (const [field, value, words] of [["Jm", "-1", "inertia"], ["K", "", "K"], ["Fm", "-0.5", "friction"]]) {
-    const before = await evaluate(`document.getElementById("plane").innerHTML`);
+    const before = await pixels();
     await evaluate(`(() => { const f = document.getElementById("f_${field}"); f.value = ${JSON.stringify(value)}; f.dispatchEvent(new Event("input")); })()`);
     await frame();
     const message = await evaluate(`document.getElementById("e_${field}").textContent`);
-    const after = await evaluate(`document.getElementById("plane").innerHTML`);
+    const after = await pixels();
     check(`bad ${field} = '${value}': inline error beside the field, drawing kept`,
-      message.length > 0 && message.includes(words) && after === before && after.length > 1000, `message "${message}"`);
+      message.length > 0 && message.includes(words) && after === before && after.length > 10000, `message "${message}"`);
     await evaluate(`document.getElementById("case").value = "V"; document.getElementById("case").dispatchEvent(new Event("change"))`);
     await frame();
   }
+  // the downloads, on case V with another loop gain (a model no case file of the thesis holds)
+  await cdp("Browser.setDownloadBehavior", { behavior: "allow", downloadPath: downloads });
+  await evaluate(`(() => { const f = document.getElementById("f_K"); f.value = "1.25"; f.dispatchEvent(new Event("input")); })()`);
+  await frame();
+  await evaluate(`window.explorer.launch({ theta_o: 0.4, dtheta_o: 0.3, flight: false })`);
+  const now = await evaluate(`(() => { const e = window.explorer, r = e.trajectories[e.trajectories.length - 1];
+    return { p2p: e.portrait.cycle.peak_to_peak, status: document.getElementById("status").textContent, start: r.start, t_end: r.t_end, dt: r.dt,
+             plane: e.scene.w + "x" + e.scene.h, caseFile: e.caseFileName() }; })()`);
+  const svg = await downloaded("dl_svg", "phase-plane.svg");
+  const parsed = svg && await evaluate(`(() => { const d = new DOMParser().parseFromString(${JSON.stringify(svg?.toString() ?? "")}, "image/svg+xml");
+    const n = (sel) => d.querySelectorAll(sel).length;
+    return { error: n("parsererror"), root: d.documentElement.nodeName, cycle: n("path.limit-cycle"), separation: n("path.separation"),
+             dividing: n("path.dividing"), trajectory: n("path.trajectory"), step: n("path.step"), events: n("circle.event") }; })()`);
+  check("download: the figure as SVG, well-formed, with the limit cycle, both separation lines, the dividing lines, the runs and their events",
+    parsed && parsed.error === 0 && parsed.root === "svg" && parsed.cycle === 1 && parsed.separation === 2 && parsed.dividing >= 1 &&
+    parsed.trajectory === 1 && parsed.step === 1 && parsed.events > 10, JSON.stringify(parsed));
+  const png = await downloaded("dl_png", "phase-plane.png");
+  const [w, h] = now.plane.split("x").map(Number);
+  const pngSize = png && png.length > 24 ? [png.readUInt32BE(16), png.readUInt32BE(20)] : null;
+  check("download: the figure as PNG (signature, twice the plane's size)",
+    png && png.subarray(0, 8).equals(Buffer.from([0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a])) && pngSize[0] === Math.round(2 * w) && pngSize[1] === Math.round(2 * h),
+    `${png?.length} bytes, ${pngSize?.join(" × ")} for a ${now.plane} plane`);
+  const csv = await downloaded("dl_case", now.caseFile) && await downloaded("dl_csv", "trajectory.csv");
+  const caseFile = path.join(downloads, now.caseFile);
+  const fromCli = fs.existsSync(caseFile) && execFileSync(cli, ["simulate", caseFile, "--from", `${now.start.theta_o},${now.start.dtheta_o}`,
+    "--t-end", String(now.t_end), "--dt", String(now.dt), "--csv"]).toString();
+  // The same rows as the CLI's (the wasm core's libm rounds a few last bits differently from the
+  // native one: the numbers agree to 1e-12 as the events do, t and the mode exactly).
+  const rows = (text) => text.trimEnd().split("\n").map((l) => l.split(","));
+  const [mine, theirs] = [csv ? rows(csv.toString()) : [], fromCli ? rows(fromCli) : []];
+  let worst = 0, same = mine.length === theirs.length && mine.length > 100;
+  for (let i = 1; same && i < mine.length; i++) {
+    same = mine[i].length === 8 && mine[i][0] === theirs[i][0] && mine[i][7] === theirs[i][7];
+    for (let k = 1; k < 7; k++) worst = Math.max(worst, Math.abs(Number(mine[i][k]) - Number(theirs[i][k])));
+  }
+  const modes = new Set(mine.slice(1).map((r) => r[7]));
+  check("download: the trajectory's CSV is `simulate FILE --from θo,θ̇o --t-end T --dt S --csv`'s: header, rows, t and mode equal, values to 1e-12",
+    same && worst <= 1e-12 && mine[0]?.join(",") === "t,theta_o,dtheta_o,theta_m,dtheta_m,theta_L,dtheta_L,mode" && modes.has("contact") && modes.has("free"),
+    `${mine.length - 1} rows, largest difference ${worst}, modes ${[...modes].join(", ")}`);
+  const fileCycle = fs.existsSync(caseFile) && backlash("limit-cycle", caseFile, "--json");
+  check("download: the case file is read by the CLI, `limit-cycle FILE --json` gives the peak-to-peak the page shows",
+    fileCycle && Math.abs(fileCycle.peak_to_peak - now.p2p) <= 1e-12 && now.status.includes(`peak-to-peak ${now.p2p}`),
+    `page ${now.p2p}, CLI ${fileCycle?.peak_to_peak}`);
+
+  // a measured record given to the page (the file input of the drop zone), then a bad one
+  const { root } = await cdp("DOM.getDocument");
+  const { nodeId } = await cdp("DOM.querySelector", { nodeId: root.nodeId, selector: "#record_file" });
+  const record = path.resolve(path.dirname(new URL(import.meta.url).pathname), "../../examples/case_V_with_hidden_friction.csv");
+  const plain = await pixels();
+  await cdp("DOM.setFileInputFiles", { nodeId, files: [record] });
+  await waitFor("window.explorer.record !== null", 10);
+  const overlay = await evaluate(`(() => { const e = window.explorer;
+    return { n: e.record.t.length, plane: e.scene.items.filter((i) => i.cls === "record").length, time: e.timeScene.items.filter((i) => i.cls === "record").length,
+             error: document.getElementById("e_record").textContent }; })()`);
+  const drawn = await pixels();
+  check("a measured record is overlaid on the phase plane and the time panel", overlay.n === 6001 && overlay.plane === 1 && overlay.time === 1 &&
+    overlay.error === "" && drawn !== plain, JSON.stringify(overlay));
+  const bad = path.join(downloads, "bad_record.csv");
+  fs.writeFileSync(bad, "t,theta_out\n" + Array.from({ length: 12 }, (_, i) => `${i === 7 ? 0.05 : i / 100},${i}`).join("\n") + "\n");
+  await cdp("DOM.setFileInputFiles", { nodeId, files: [bad] });
+  await waitFor(`document.getElementById("e_record").textContent !== ""`, 10);
+  const message = await evaluate(`document.getElementById("e_record").textContent`);
+  check("a bad record: the inline error names the file, line and column; the drawing is kept",
+    message.startsWith("bad_record.csv:9: t:") && message.includes("strictly increasing") && (await pixels()) === drawn, `"${message}"`);
+
   check("no script error on the page", consoleErrors.length === 0, consoleErrors.join("; "));
 
   // screenshots of the eight thesis cases, and the redraw rate while a slider moves
   for (const id of ["I", "II", "III", "IV", "V", "VI", "VII", "VIII"]) {
     await evaluate(`document.getElementById("case").value = "${id}"; document.getElementById("case").dispatchEvent(new Event("change"))`);
     await frame();
-    const rate = await evaluate(`(() => {
-      const e = window.explorer, slider = document.getElementById("s_FL"), n = 12, t = { load: 0, portrait: 0, runs: 0, draw: 0 };
-      const v0 = Number(slider.value), t0 = performance.now();
-      for (let i = 1; i <= n; i++) {
-        slider.value = v0 * (1 + 0.02 * i) + 0.001 * i; slider.dispatchEvent(new Event("input")); e.update();
-        t.load += e.timings.load_ms; t.portrait += e.portrait.ms; t.draw += e.timings.draw_ms;
-        t.runs += e.timings.compute_ms - e.timings.load_ms - e.portrait.ms;
-      }
-      const fps = n / ((performance.now() - t0) / 1000);
-      const s0 = performance.now(); slider.dispatchEvent(new Event("change")); const slice = performance.now() - s0;
-      slider.value = v0; slider.dispatchEvent(new Event("input")); e.update();
-      for (const k in t) t[k] /= n;
-      return { fps, slice, ...t };
-    })()`);
-    console.log(`MEASURED case ${id}: slider redraw ${rate.fps.toFixed(1)} frames/s (per frame: model ${rate.load.toFixed(1)} ms, ` +
-      `portrait ${rate.portrait.toFixed(1)} ms, step response and trajectories ${rate.runs.toFixed(1)} ms, drawing ${rate.draw.toFixed(1)} ms); ` +
-      `live slice on release ${rate.slice.toFixed(0)} ms (25 limit cycles)`);
     await frame();
     const shot = await cdp("Page.captureScreenshot", { format: "png" });
     fs.writeFileSync(path.join(artifacts, `explorer_case_${id}.png`), Buffer.from(shot.data, "base64"));
@@ -194,7 +206,7 @@ try {
   check("the browser session", false, error.message);
 }
 clearTimeout(watchdog);
-browser.kill("SIGKILL");
-fs.rmSync(profile, { recursive: true, force: true });
+b.close();
+if (!process.env.KEEP_DOWNLOADS) fs.rmSync(downloads, { recursive: true, force: true });
 console.log(failures.length ? `${failures.length} check(s) failed` : "all checks passed");
 process.exit(failures.length ? 1 : 0);
