@@ -165,8 +165,22 @@ std::string load_case(const std::string& pairs_json) {
   });
 }
 
+/// The θ̇m0 of the dividing lines of both faces, as the report draws them (reports/src/
+/// case_results.cpp): the default grid (numeric::default_dividing_line_grid, θ̇m0 > 0: the
+/// separation from the face x = −b/2) and its negatives (from x = +b/2).
+const std::vector<double>& both_faces() {
+  static const std::vector<double> grid = [] {
+    std::vector<double> v = numeric::default_dividing_line_grid();
+    const std::size_t n = v.size();
+    for (std::size_t i = 0; i < n; ++i) v.push_back(-v[i]);
+    return v;
+  }();
+  return grid;
+}
+
 /// The limit cycle (the CLI's `limit-cycle --json`) and one period of its orbit from its
-/// separation point (as the report draws it); the dividing lines (`trace --json`).
+/// separation point (as the report draws it); the dividing lines of both faces (`trace --json`
+/// at both_faces()).
 std::string portrait() {
   return guarded([&] {
     const auto t0 = std::chrono::steady_clock::now();
@@ -183,7 +197,7 @@ std::string portrait() {
     }
     head["cycle_ms"] = milliseconds_since(t0);
     const auto t1 = std::chrono::steady_clock::now();
-    const std::string trace = m.trace().json();
+    const std::string trace = m.trace(both_faces()).json();
     head["trace_ms"] = milliseconds_since(t1);
     head["ms"] = milliseconds_since(t0);
     std::string out = head.dump();

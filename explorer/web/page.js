@@ -300,7 +300,7 @@
       curve(sc, [R - Y[0] / iso.slope, R - Y[1] / iso.slope], Y, toP, { stroke: "#d0d0d0", cls: "isocline" });
     const c = S.loaded.cot_phi;  // the separation line θo = θR + cot φ·θ̇o: its half leaving each face
     curve(sc, [R, R + c * Y[1]], [0, Y[1]], toP, { stroke: "#ff7f0e", width: 1.6, cls: "separation" });
-    curve(sc, [R, R + c * Y[0]], [0, Y[0]], toP, { stroke: "#d62728", width: 1.6, dash: [6, 3], cls: "separation" });
+    curve(sc, [R, R + c * Y[0]], [0, Y[0]], toP, { stroke: "#ff7f0e", width: 1.6, dash: [6, 3], cls: "separation" });
     dividingLines(sc, toP);
     if (S.portrait.orbit) curve(sc, S.portrait.orbit.theta_o, S.portrait.orbit.dtheta_o, toP, { stroke: "#e00", width: 2.4, cls: "limit-cycle" });
     if (S.record) curve(sc, S.record.thetaForPlane, S.record.dtheta, toP, { stroke: "#000", dash: [2, 2], cls: "record" });
@@ -319,16 +319,18 @@
     drawEvents();
     S.timings.draw_ms = performance.now() - t0;
   }
-  function dividingLines(sc, toP) {  // trace: recombination (or recontact) states after the impact, per sign of θ̇m0
-    const pts = S.portrait.trace.points.filter((q) => q.theta_o !== null);
-    const groups = {};
-    for (const q of pts) (groups[(q.v0 > 0 ? "+" : "−") + q.status] ||= []).push(q);
-    const styles = ["#6a3d9a", "#b15928", "#33a02c", "#a6cee3"];
-    Object.keys(groups).sort().forEach((k, i) => {
-      const q = groups[k].sort((a, b) => a.v0 - b.v0);
-      curve(sc, q.map((x) => x.theta_o), q.map((x) => x.dtheta_o), toP, { stroke: styles[i % 4], width: 1.3, dash: [1, 2], cls: "dividing" });
-    });
-    S.dividingGroups = Object.keys(groups).sort();
+  /// The dividing lines (trace at θ̇m0 of both signs: the separation from each face), as the
+  /// report draws them: per face, the loci of the motor and of the load just before the impact
+  /// and of the recombined state just after it (eq. 24); points that never recombine left out.
+  const LOCI = [["motor", "theta_m", "dtheta_m", "#1f5fbf"], ["load", "theta_L", "dtheta_L", "#2a9d3a"], ["recombined", "theta_o", "dtheta_o", "#d62728"]];
+  function dividingLines(sc, toP) {
+    const pts = S.portrait.trace.points.filter((q) => q.theta_o !== null && q.status !== "none");
+    for (const [face, sign] of [["−b/2", 1], ["+b/2", -1]]) {
+      const q = pts.filter((x) => Math.sign(x.v0) === sign).sort((a, b) => a.v0 - b.v0);
+      for (const [locus, x, y, color] of LOCI)
+        curve(sc, q.map((p) => p[x]), q.map((p) => p[y]), toP, { stroke: color, width: locus === "recombined" ? 1.5 : 1.1, dash: locus === "recombined" ? [4, 2] : [1, 2],
+          cls: `dividing ${locus}`, face });
+    }
   }
   function run(sc, r, color, width, toP, cls) {
     curve(sc, r.samples.theta_o, r.samples.dtheta_o, toP, { stroke: color, width, cls });
@@ -337,13 +339,15 @@
   }
   function legendText() {
     const c = S.portrait.cycle;
-    return "separation line (leaving x = −b/2: solid, x = +b/2: dashed), dividing lines (dotted), isoclines (grey), step response (dark grey), " +
+    return "separation line (orange; leaving x = −b/2: solid, x = +b/2: dashed), dividing lines of both faces (motor blue, load green, " +
+      "recombined red dashed), isoclines (grey), step response (dark grey), " +
       (c.status === "limit_cycle" ? `limit cycle (red, peak-to-peak ${c.peak_to_peak.toPrecision(6)})` : `no limit cycle: ${c.status} — ${c.reason}`);
   }
   function legend() {
     const c = S.portrait.cycle;
-    $("legend").innerHTML = `<span style="color:#ff7f0e">━</span> separation line (leaving x = −b/2) ` +
-      `<span style="color:#d62728">╍</span> (leaving x = +b/2) <span style="color:#6a3d9a">┈</span> dividing lines ` +
+    $("legend").innerHTML = `<span style="color:#ff7f0e">━</span> separation line (leaving x = −b/2, θ̇o > 0) ` +
+      `<span style="color:#ff7f0e">╍</span> (leaving x = +b/2, θ̇o < 0); dividing lines of both faces: <span style="color:#1f5fbf">┈</span> motor ` +
+      `<span style="color:#2a9d3a">┈</span> load before the impact <span style="color:#d62728">╍</span> recombined; ` +
       `<span style="color:#d0d0d0">━</span> isoclines <span style="color:#555">━</span> step response ` +
       (c.status === "limit_cycle" ? `<span style="color:#e00">━</span> limit cycle (peak-to-peak ${c.peak_to_peak.toPrecision(6)})`
         : `<b>no limit cycle</b>: ${c.status} — ${c.reason}`);
@@ -478,7 +482,7 @@
   $("dl_svg").onclick = () => download("phase-plane.svg", new Blob([svgText()], { type: "image/svg+xml" }));
   $("dl_png").onclick = () => {
     const canvas = document.createElement("canvas");
-    canvas.width = S.scene.w * 2; canvas.height = S.scene.h * 2;
+    canvas.width = Math.round(S.scene.w * 2); canvas.height = Math.round(S.scene.h * 2);
     paintOn(canvas.getContext("2d"), S.scene, 2);
     canvas.toBlob((b) => download("phase-plane.png", b));
   };

@@ -95,6 +95,26 @@ try {
   const stepEvents = await evaluate("window.explorer.step.simulation.events");
   sameEvents("case V: step-response events equal `simulate V --json`", stepEvents, backlash("simulate", "V", "--json").events);
 
+  // the dividing lines of both faces: θ̇m0 > 0 (separation from x = −b/2) are `trace V --json`'s
+  // points; θ̇m0 < 0 (from x = +b/2) their mirror images about (θR, 0) (the odd symmetry, docs/physics.md)
+  await part("the dividing lines", async () => {
+    const points = await evaluate("window.explorer.portrait.trace.points");
+    const cli = backlash("trace", "V", "--json").points, R = 1, keys = ["theta_m", "dtheta_m", "theta_L", "dtheta_L", "theta_o", "dtheta_o"];
+    const positive = points.filter((q) => q.v0 > 0), negative = points.filter((q) => q.v0 < 0);
+    let worst = 0, mirrored = 0, same = positive.length === cli.length && negative.length === cli.length;
+    for (let i = 0; same && i < cli.length; i++) {
+      const m = negative.find((q) => q.v0 === -cli[i].v0);
+      same = positive[i].v0 === cli[i].v0 && positive[i].status === cli[i].status && m !== undefined && m.status === cli[i].status;
+      if (!same || cli[i].theta_o === null) continue;
+      for (const k of keys) {
+        worst = Math.max(worst, Math.abs(positive[i][k] - cli[i][k]));
+        mirrored = Math.max(mirrored, Math.abs(m[k] - (k.startsWith("d") ? -cli[i][k] : 2 * R - cli[i][k])));
+      }
+    }
+    check("dividing lines of both faces: θ̇m0 > 0 equal `trace V --json`, θ̇m0 < 0 their mirror images about (θR, 0), to 1e-12",
+      same && worst <= 1e-12 && mirrored <= 1e-12, `${positive.length} + ${negative.length} points, largest difference ${worst}, from the mirror ${mirrored}`);
+  });
+
   // a scripted click on the phase plane, in contact and in flight
   for (const [flight, x, y] of [[false, 0.3, 0.45], [true, 1.6, -0.35]]) {
     if (flight) await evaluate(`document.getElementById("flight").click()`);
@@ -146,7 +166,7 @@ try {
       return { error: n("parsererror"), root: d.documentElement.nodeName, cycle: n("path.limit-cycle"), separation: n("path.separation"),
                dividing: n("path.dividing"), trajectory: n("path.trajectory"), step: n("path.step"), events: n("circle.event") }; })()`);
     check("download: the figure as SVG, well-formed, with the limit cycle, both separation lines, the dividing lines, the runs and their events",
-      parsed && parsed.error === 0 && parsed.root === "svg" && parsed.cycle === 1 && parsed.separation === 2 && parsed.dividing >= 1 &&
+      parsed && parsed.error === 0 && parsed.root === "svg" && parsed.cycle === 1 && parsed.separation === 2 && parsed.dividing === 6 &&
       parsed.trajectory === 1 && parsed.step === 1 && parsed.events > 10, JSON.stringify(parsed));
     const png = await downloaded("dl_png", "phase-plane.png");
     const [w, h] = now.plane.split("x").map(Number);
@@ -201,6 +221,7 @@ try {
 
   check("no script error on the page", consoleErrors.length === 0, consoleErrors.join("; "));
 
+  await evaluate("window.explorer.record = null");  // the screenshots without the record
   // screenshots of the eight thesis cases, and the redraw rate while a slider moves
   for (const id of ["I", "II", "III", "IV", "V", "VI", "VII", "VIII"]) {
     await evaluate(`document.getElementById("case").value = "${id}"; document.getElementById("case").dispatchEvent(new Event("change"))`);
