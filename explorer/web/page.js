@@ -10,7 +10,7 @@
     ["Jm", "motor inertia Jm"], ["Fm", "motor friction Fm"], ["JL", "load inertia JL"], ["FL", "load friction FL"],
     ["K", "loop gain K"], ["backlash", "backlash b"], ["reference", "reference θR"], ["step", "step A"], ["t_end", "t_end [s]"]];
   const EFFECTS = JSON.parse(core.effect_table());
-  const COLORS = ["#1f77b4", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#17becf"];
+  const COLORS = ["#9467bd", "#17becf", "#8c564b", "#e377c2", "#bcbd22", "#7f7f7f"];  // apart from the loci's blue, green, red
 
   const S = {  // the page's state; window.explorer exposes it to the browser tests
     loaded: null, portrait: null, step: null, trajectories: [], lastStart: null, record: null,
