@@ -217,6 +217,18 @@ try {
     const message = await evaluate(`document.getElementById("e_record").textContent`);
     check("a bad record: the inline error names the file, line and column; the drawing is kept",
       message.startsWith("bad_record.csv:9: t:") && message.includes("strictly increasing") && (await pixels()) === drawn, `"${message}"`);
+    // dropped on the page (a drop event carrying the file, as a drag from the desktop delivers
+    // it): a record without theta_out, then the good one again
+    const drop = (name, text) => evaluate(`(() => { const d = new DataTransfer(); d.items.add(new File([${JSON.stringify(text)}], "${name}"));
+      document.getElementById("plane").dispatchEvent(new DragEvent("drop", { dataTransfer: d, bubbles: true, cancelable: true })); })()`);
+    await drop("no_theta_out.csv", "t,theta_motor\n" + Array.from({ length: 12 }, (_, i) => `${i},${i}`).join("\n") + "\n");
+    await waitFor(`document.getElementById("e_record").textContent.startsWith("no_theta_out.csv")`, 10);
+    const dropped = await evaluate(`document.getElementById("e_record").textContent`);
+    await drop("again.csv", fs.readFileSync(record, "utf8"));
+    await waitFor(`window.explorer.record.name === "again.csv"`, 10);
+    check("dropped on the page: a record without theta_out gives the inline error, a good one is overlaid",
+      dropped.startsWith("no_theta_out.csv:1: theta_out: missing column") && (await evaluate(`document.getElementById("e_record").textContent`)) === "" &&
+      (await evaluate("window.explorer.record.t.length")) === 6001, `"${dropped}"`);
   });
 
   check("no script error on the page", consoleErrors.length === 0, consoleErrors.join("; "));
