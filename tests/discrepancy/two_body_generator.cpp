@@ -463,10 +463,10 @@ TwoBodyRecord generate_two_body_record(const TwoBodyRecordSpec& spec) {
     const TwoBodyState s = plant.state();
     const auto [ref, ref_rate] = reference.at(t);
     const double ym = encoder(s.theta_m), yl = encoder(s.theta_l), y = loop.on_load ? yl : ym;
-    if (k == 0) previous = y;
+    if (k == 0) previous = ym;
     integral += loop.ki * T * (ref - y);
-    u = loop.kp * (ref - y) + loop.kv * (ref_rate - (y - previous) / T) + integral;
-    previous = y;
+    u = loop.kp * (ref - y) + loop.kv * (ref_rate - (ym - previous) / T) + integral;
+    previous = ym;
     if (!(std::fabs(s.theta_m - ref) < 10 * r.amplitude + M_PI) || !(std::fabs(s.theta_l - ref) < 10 * r.amplitude + M_PI))
       throw std::runtime_error("two-body generator: the loop ran away at t = " + std::to_string(t) + " s");
     out.t.push_back(t);
@@ -479,7 +479,7 @@ TwoBodyRecord generate_two_body_record(const TwoBodyRecordSpec& spec) {
   for (double c : out.torque) out.drive.push_back(c / spec.gain + spec.current_noise * gaussian(random));
   int direction = 0;
   for (const TwoBodyState& s : out.state) {
-    const int now = std::fabs(s.omega_m) > 0.01 * r.speed ? sign_of(s.omega_m) : 0;
+    const int now = std::fabs(s.omega_m) > 0.3 * r.speed ? sign_of(s.omega_m) : 0;
     if (now != 0 && direction != 0 && now != direction) ++out.reversals;
     if (now != 0) direction = now;
   }

@@ -19,9 +19,11 @@
 //                      (Jm + JL)·ω⁺ = Jm·θ̇m + JL·θ̇L, and then move as one body while the
 //                      torque the motor transmits keeps its holding sign (docs/physics.md,
 //                      "Gap, faces, events"); they part when it changes sign;
-//   the controller digital, every `period` T on the QUANTISED encoder y of the motor or the load:
+//   the controller digital, every `period` T, the position on the QUANTISED encoder y of the
+//                  motor or the load, the velocity on the quantised motor encoder ym (a
+//                  dual-loop drive when y is the load's):
 //                    e_k = r_k − y_k,  I_k = I_{k−1} + ki·T·e_k,
-//                    u_k = kp·e_k + kv·(ṙ_k − (y_k − y_{k−1})/T) + I_k
+//                    u_k = kp·e_k + kv·(ṙ_k − (ym_k − ym_{k−1})/T) + I_k
 //                  (kv = ki = 0: a pure P position loop; ki > 0: PI), held on [t_k, t_{k+1});
 //   the reference  a trapezoid between −A and +A: rests, moves at speed V with smooth (quintic
 //                  velocity) ramps, `moves` moves, so moves − 1 reversals of the motion;
@@ -95,9 +97,9 @@ TwoBodyRun simulate_two_body(const TwoBodyPlant& plant, const std::vector<double
 
 struct TwoBodyLoop {
   double period = 1e-3;   ///< T [s]
-  bool on_load = false;   ///< the loop closed on the load encoder (backlash inside the loop)
-  double kp = 4;          ///< position gain [N·m/rad]
-  double kv = 0.2;        ///< velocity gain on the encoder's backward difference [N·m·s/rad]
+  bool on_load = false;   ///< the position loop closed on the load encoder (backlash inside it)
+  double kp = 20;         ///< position gain [N·m/rad]
+  double kv = 1.2;        ///< velocity gain on the motor encoder's backward difference [N·m·s/rad]
   double ki = 0;          ///< integral gain [N·m/(rad·s)]
 };
 
@@ -126,7 +128,7 @@ struct TwoBodyRecord {
   std::vector<TwoBodyState> state;                        ///< the true state at t_k
   TwoBodyEvents events;
   TwoBodyEnergy energy;
-  int reversals = 0;  ///< of the motor's true motion (sign changes of θ̇m beyond 1 % of V)
+  int reversals = 0;  ///< of the motor's true motion (sign changes of θ̇m beyond 30 % of V)
 };
 
 /// The closed-loop record, deterministic for a given spec.  std::invalid_argument for a spec
