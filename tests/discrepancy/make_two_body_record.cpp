@@ -1,7 +1,10 @@
 // make_two_body_record — writes a record of the independent two-body generator
 // (two_body_generator.hpp) and the matching model file, from command-line parameters.
-// Made the README's example (examples/two_body_drive.{csv,toml}):
-//   make_two_body_record --backlash-deg 2 --csv examples/two_body_drive.csv --toml examples/two_body_drive.toml
+// Made the README's example (examples/two_body_drive.{csv,toml}; the model's backlash 1.5° and
+// load inertia 25 % high, both free):
+//   make_two_body_record --backlash-deg 2 --amplitude 0.4 --ramp 0.08 --rest 0.1
+//     --nominal backlash=0.75 --nominal load.J=1.25 --free backlash --free load.J
+//     --csv examples/two_body_drive.csv --toml examples/two_body_drive.toml
 //
 //   --csv FILE, --toml FILE   the outputs (required)
 //   --backlash-deg B          the true total backlash [degrees] (default 2)
@@ -11,7 +14,7 @@
 //   --coulomb-motor C, --coulomb-load C   Coulomb friction [N·m] (default 0)
 //   --jm, --fm, --jl, --fl    the bodies (defaults of TwoBodyPlant)
 //   --kp, --kv, --ki          the loop's gains (defaults of TwoBodyLoop)
-//   --amplitude A, --speed V, --moves N   the reference (defaults of TwoBodyReference)
+//   --amplitude A, --speed V, --ramp S, --rest S, --moves N   the reference (defaults of TwoBodyReference)
 //   --counts N                encoder counts per revolution (default 65536)
 //   --noise S                 σ of the logged drive's noise [N·m] (default 0.002)
 //   --seed N                  the noise's seed (default 1)
@@ -64,7 +67,8 @@ int main(int argc, char** argv) try {
       {"--coulomb-motor", &spec.plant.coulomb_motor}, {"--coulomb-load", &spec.plant.coulomb_load},
       {"--jm", &spec.plant.Jm}, {"--fm", &spec.plant.Fm}, {"--jl", &spec.plant.JL}, {"--fl", &spec.plant.FL},
       {"--kp", &spec.loop.kp}, {"--kv", &spec.loop.kv}, {"--ki", &spec.loop.ki},
-      {"--amplitude", &spec.reference.amplitude}, {"--speed", &spec.reference.speed}, {"--noise", &spec.current_noise}};
+      {"--amplitude", &spec.reference.amplitude}, {"--speed", &spec.reference.speed}, {"--ramp", &spec.reference.ramp},
+      {"--rest", &spec.reference.rest}, {"--noise", &spec.current_noise}};
   for (int i = 1; i < argc; ++i) {
     const std::string flag = argv[i];
     if (flag == "--motor-only") {
@@ -94,8 +98,17 @@ int main(int argc, char** argv) try {
   model.nominal = spec.plant;
   for (const std::string& n : nominal) scale(model.nominal, n);
   model.free = free;
-  model.name = "geared servo, " + std::string(both ? "both encoders" : "motor encoder") + " (generated, backlash " +
-               std::to_string(spec.plant.backlash * 180 / M_PI).substr(0, 6) + " deg)";
+  model.name = std::string("geared servo with backlash (generated record, ") + (both ? "both encoders)" : "motor encoder)");
+  char truth[512];
+  std::snprintf(truth, sizeof truth,
+                "Made by make_two_body_record (tests/discrepancy/two_body_generator.hpp). The truth:\n"
+                "backlash %.6g rad (%.4g deg), motor J %.6g F %.6g, load J %.6g F %.6g, stiffness %s, Coulomb %.6g / %.6g N·m;\n"
+                "a P position loop (kp %.4g N·m/rad) with velocity feedback (kv %.4g N·m·s/rad) on the %s encoder,\n%ld counts/rev, %zu samples at %.6g s, logged-drive noise %.3g N·m.",
+                spec.plant.backlash, spec.plant.backlash * 180 / M_PI, spec.plant.Jm, spec.plant.Fm, spec.plant.JL, spec.plant.FL,
+                std::isinf(spec.plant.stiffness) ? "rigid" : std::to_string(spec.plant.stiffness).c_str(), spec.plant.coulomb_motor,
+                spec.plant.coulomb_load, spec.loop.kp, spec.loop.kv, spec.loop.on_load ? "load" : "motor", spec.counts_per_rev, record.t.size(), spec.loop.period,
+                spec.current_noise);
+  model.comment = truth;
   write_text_file(csv, two_body_csv(record, both));
   write_text_file(toml, two_body_case_toml(model));
   std::printf("%zu samples, %d reversals, %d impacts, %d engagements, %d sticks\n", record.t.size(), record.reversals,

@@ -498,7 +498,14 @@ std::string two_body_csv(const TwoBodyRecord& record, bool both_encoders) {
 
 std::string two_body_case_toml(const TwoBodyCase& model) {
   const TwoBodyPlant& p = model.nominal;
-  std::string toml = "name = \"" + model.name + "\"\nmeasured_at = \"motor\"\nbacklash = " + number(p.backlash) +
+  std::string toml;
+  std::size_t from = 0;
+  while (!model.comment.empty() && from <= model.comment.size()) {
+    const std::size_t end = std::min(model.comment.find('\n', from), model.comment.size());
+    toml += "# " + model.comment.substr(from, end - from) + "\n";
+    from = end + 1;
+  }
+  toml += "name = \"" + model.name + "\"\nmeasured_at = \"motor\"\nbacklash = " + number(p.backlash) +
                      "\nreference = 0\n\n[motor]\nJ = " + number(p.Jm) + "\nF = " + number(p.Fm) + "\n\n[load]\nJ = " +
                      number(p.JL) + "\nF = " + number(p.FL) + "\n\n[experiment]\nkind = \"drive\"\ndrive_gain = " +
                      number(model.drive_gain) + "\n";

@@ -147,6 +147,7 @@ std::string two_body_csv(const TwoBodyRecord& record, bool both_encoders);
 /// Coulomb frictions and a finite mesh stiffness as `compliance`), `[fit] free` if given.
 struct TwoBodyCase {
   std::string name = "generated two-body drive";
+  std::string comment;  ///< written first, each line as a TOML comment
   TwoBodyPlant nominal;
   double drive_gain = 1;
   std::vector<std::string> free;  ///< e.g. "backlash", "load.J", "load.F"
