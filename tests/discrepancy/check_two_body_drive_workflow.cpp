@@ -86,6 +86,31 @@ TEST(TwoBodyGenerator, HandSolvedFreeFlight) {
               0.5 * p.Jm * p.JL / (p.Jm + p.JL) * std::pow(u * (t3 - t2) / p.Jm, 2), 1e-12);
 }
 
+// Coulomb friction on the load alone: the motor (torque u until t2, then none) hits the stuck
+// load at t1 = sqrt(b·Jm/u), pushes it (J·ω' = u − CL), then coasts pushing it (the load's
+// friction keeps the contact: J·ω' = −CL) until both stop and stick at t2 + ω2·J/CL, where they
+// stay (no torque): θ = θ(t2) + ω2²·J/(2·CL).
+TEST(TwoBodyGenerator, HandSolvedCoulombStop) {
+  TwoBodyPlant p;
+  p.Jm = 0.01, p.JL = 0.03, p.Fm = 0, p.FL = 0, p.backlash = 0.05, p.coulomb_load = 0.03;
+  const double u = 0.2, t2 = 0.2, J = p.Jm + p.JL, CL = p.coulomb_load;
+  std::vector<double> t, torque;
+  for (int k = 0; k <= 1500; ++k) t.push_back(1e-3 * k), torque.push_back(k < 200 ? u : 0);
+  const TwoBodyRun run = simulate_two_body(p, t, torque, {});
+  const double t1 = std::sqrt(p.backlash * p.Jm / u), w2 = u * t1 / J + (u - CL) * (t2 - t1) / J;
+  const double stop = t2 + w2 * J / CL;
+  ASSERT_EQ(run.events.impacts, 1);
+  EXPECT_EQ(run.events.sticks, 1);
+  EXPECT_EQ(run.events.separations, 0);
+  EXPECT_NEAR(run.state[200].omega_m, w2, 1e-12);
+  const std::size_t before = static_cast<std::size_t>(std::floor(stop * 1e3));
+  EXPECT_NEAR(run.state[before].omega_l, w2 - CL / J * (t[before] - t2), 1e-12);
+  EXPECT_EQ(run.state.back().omega_m, 0.0);
+  EXPECT_EQ(run.state.back().omega_l, 0.0);
+  EXPECT_NEAR(run.state.back().theta_m - run.state[200].theta_m, w2 * w2 * J / (2 * CL), 1e-12);
+  EXPECT_NEAR(run.energy.work, run.energy.kinetic + run.energy.dissipated + run.energy.impact_losses, 1e-8 * run.energy.work);  // ∫CL·|ω| at odeint's tolerance
+}
+
 TwoBodyRecordSpec base_spec(double backlash) {
   TwoBodyRecordSpec spec;
   spec.plant.backlash = backlash;
