@@ -8,7 +8,7 @@
 // integrated by Boost.Odeint with its own event logic — nothing of numeric/ or discrepancy/).
 //
 // TwoBodyGenerator: the generator itself — contact and flight times of a hand-solved
-// free-flight case, the energy balance of closed-loop runs (rigid impacts, a compliant mesh,
+// free-flight case, a hand-solved Coulomb stop and stick, the energy balance of closed-loop runs (rigid impacts, a compliant mesh,
 // Coulomb friction on both bodies), the gap held within its faces, the log's form
 // (encoder counts, reversals, the CSV's columns, the model file), a bad spec refused.
 //
