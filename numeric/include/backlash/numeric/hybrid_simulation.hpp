@@ -31,6 +31,7 @@
 
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -101,6 +102,17 @@ struct SimulationOptions {
   double zeno_window = 0;
   long stop_after_separations = 0;  ///< > 0: stop (status completed) right after this many separations
   bool track_extremes = false;      ///< record the exact extremes of θo, θm, θL (zeros of the velocities)
+  /// Set (θo in the caller's frame): samples that certainly lie in [low, high] may be left out,
+  /// for a caller that needs only the samples outside (settle.hpp).  The closed-form simulator
+  /// skips the sample times of a segment whose θo at its ends and at its turns (the zeros of θ̇o,
+  /// in closed form: hybrid/sample_band.hpp) lies inside the band by a margin of four times the
+  /// evaluator's validated tolerance (scaled like the gate's: max(1, |θ|)); the sink sees the
+  /// other samples, each with its own time, as computed without the band.  Other simulators
+  /// ignore it.
+  struct SampleBand {
+    double low, high;
+  };
+  std::optional<SampleBand> sample_band;
 };
 
 /// Exact extremes over the simulated time: at event states and at the certified
@@ -164,6 +176,15 @@ class TrajectoryRecorder {
     for (double next = static_cast<double>(k_) * o_.sample_interval; next <= t_upto;
          next = static_cast<double>(++k_) * o_.sample_interval)
       push(next, at(next - t0));
+  }
+  /// Passes over the sample times ≤ t_upto without recording them (SimulationOptions::sample_band).
+  void skip(double t_upto) {
+    if (!o_.sample_times.empty()) {
+      while (index_ < o_.sample_times.size() && o_.sample_times[index_] <= t_upto) ++index_;
+      return;
+    }
+    if (o_.sample_interval <= 0) return;
+    while (static_cast<double>(k_) * o_.sample_interval <= t_upto) ++k_;
   }
 
  private:
