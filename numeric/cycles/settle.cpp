@@ -24,8 +24,8 @@ SimulationOptions::SampleBand moving_band(const Parameters& p, const LimitCycle&
   return {p.theta_R - tol, p.theta_R + tol};
 }
 
-// The samples, all of them or (`band`) those the simulator could not certify inside the band
-// (SimulationOptions::sample_band): the judge needs only the last one outside.
+// The samples, all of them or (`band`) those the last one outside the band needs
+// (SimulationOptions::sample_band).
 SimulationOptions sampled(const SettleOptions& o, std::vector<Sample>& theta_o,
                           std::optional<SimulationOptions::SampleBand> band) {
   SimulationOptions s;
@@ -49,16 +49,11 @@ long long last_sample(const SettleOptions& o) {
   return k;
 }
 
-// True when samples were left out: the simulator records k = 0, 1, … in order, so a list
-// with a gap (or none at all) is one the band thinned.
-bool thinned(const std::vector<Sample>& theta_o) {
-  return theta_o.empty() || theta_o.back().k + 1 != static_cast<long long>(theta_o.size());
-}
-
-// The band (settle.hpp) and the first sample time after which every sample stays in it; the
-// samples left out of a `thinned` list lie in the band.
+// The band (settle.hpp) and the first sample time after which every sample stays in it.  A run
+// with samples left out (SimulationOptions::sample_band) recorded the last one outside the band and
+// every one near its edges: the others lie inside, or before a later one outside.
 Settle judge(const SimulationResult& run, const std::vector<Sample>& theta_o, const Parameters& p,
-             const LimitCycle& cycle, const SettleOptions& o, bool thinned) {
+             const LimitCycle& cycle, const SettleOptions& o) {
   Settle s;
   if (stopped_early(run.status)) {
     s.status = to_string(run.status);
@@ -73,6 +68,7 @@ Settle judge(const SimulationResult& run, const std::vector<Sample>& theta_o, co
   auto inside = [&](double x) { return x >= s.band_low && x <= s.band_high; };
   std::size_t n = theta_o.size();  // one past the last sample outside
   while (n > 0 && inside(theta_o[n - 1].theta_o)) --n;
+  const bool thinned = run.samples_left_out > 0;
   const bool last_outside = thinned ? n > 0 && n == theta_o.size() && theta_o.back().k == last_sample(o)
                                     : theta_o.empty() || n == theta_o.size();
   if (run.status != SimulationStatus::Rest && last_outside) {
@@ -84,16 +80,17 @@ Settle judge(const SimulationResult& run, const std::vector<Sample>& theta_o, co
   return s;
 }
 
-// The settle time from `simulate(options)`: with the samples certainly inside the band left out,
-// again with all of them when that run stopped at rest after leaving some out (its band is θ∞'s).
+// The settle time from `simulate(options)`: with samples left out by the moving band, again with
+// all of them when that run stopped at rest after leaving some out (its band is θ∞'s).
 template <class Simulate>
 Settle settled(const Simulate& simulate, const Parameters& p, const LimitCycle& cycle, const SettleOptions& o) {
   std::vector<Sample> theta_o;
   SimulationResult run = simulate(sampled(o, theta_o, moving_band(p, cycle, o.fraction * std::fabs(o.step))));
-  if (run.status != SimulationStatus::Rest || !thinned(theta_o)) return judge(run, theta_o, p, cycle, o, thinned(theta_o));
-  theta_o.clear();
-  run = simulate(sampled(o, theta_o, std::nullopt));
-  return judge(run, theta_o, p, cycle, o, false);
+  if (run.status == SimulationStatus::Rest && run.samples_left_out > 0) {
+    theta_o.clear();
+    run = simulate(sampled(o, theta_o, std::nullopt));
+  }
+  return judge(run, theta_o, p, cycle, o);
 }
 
 }  // namespace

@@ -277,6 +277,11 @@ HybridState rigid_start(const Parameters& p, const HybridState& start) {
 
 namespace {
 
+// A sample band (SimulationOptions::sample_band) in a run's frame, and its margin.
+struct Band {
+  double low, high, margin;
+};
+
 // One run of the closed-form hybrid automaton from a start state: contact segments (the
 // validated closed form, separation at the first certified zero of Tc) and free flights (the
 // first certified gap event), joined by the impact law.
@@ -284,9 +289,9 @@ class ClosedFormRun {
  public:
   /// `start_gap`: the gap x = θL − θm of a free start strictly inside the backlash, computed
   /// before any shift of the angles (simulate); none for every other start.
-  /// `band`: options.sample_band in this run's frame, narrowed by its margin.
+  /// `band`: options.sample_band in this run's frame, with its margin.
   ClosedFormRun(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options,
-                std::optional<double> start_gap, std::optional<SimulationOptions::SampleBand> band)
+                std::optional<double> start_gap, std::optional<Band> band)
       : evaluator_(evaluator),
         p_(evaluator.parameters()),
         o_(options),
@@ -379,7 +384,7 @@ class ClosedFormRun {
   const bool rigid_;
   HybridState state_;
   std::optional<double> start_gap_;  // the first flight's gap x(0) when it starts inside the backlash
-  const std::optional<SimulationOptions::SampleBand> band_;  // narrowed by its margin (simulate)
+  const std::optional<Band> band_;  // options.sample_band in this run's frame (band_in_frame)
   double t_ = 0;
   ImpactWindow impacts_;
   long separations_ = 0;
@@ -510,22 +515,22 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   return impact(*event, before);
 }
 
-// The samples of a segment (its state `at(τ)`, τ = t − t_) at the times ≤ upto — none when its θo
-// on [0, upto − t_] certainly lies in the sample band: at both ends and at its turns (`turns`,
-// sample_band.hpp) inside the band already narrowed by the margin (SimulationOptions::sample_band).
+// The samples of a segment (its state `at(τ)`, τ = t − t_) at the times ≤ upto; with a sample band
+// (SimulationOptions::sample_band) none when its θo on [0, upto − t_] certainly lies in the band (at
+// both ends and at its turns, `turns`: sample_band.hpp, inside by the margin), else those the last
+// sample outside needs (TrajectoryRecorder::record_last_outside).
 template <class At>
 void ClosedFormRun::record(double upto, const At& at, FunctionRef<int(double, double*, int)> turns) {
-  const double duration = upto - t_;
-  const auto inside = [this, &at](double tau) {
-    const double o = measured(p_, at(tau));
-    return o >= band_->low && o <= band_->high;
-  };
+  if (!band_) return recorder_.record(t_, upto, at);
+  const Band& b = *band_;
+  const auto keep = [&b](double o) { return !(o >= b.low + b.margin && o <= b.high - b.margin); };
+  const auto last = [&b](double o) { return o < b.low - b.margin || o > b.high + b.margin; };
   std::array<double, 8> times;
-  int count = band_ ? turns(duration, times.data(), static_cast<int>(times.size())) : -1;
-  bool skip = count >= 0 && inside(0) && inside(duration);
-  for (int i = 0; skip && i < count; ++i) skip = inside(times[i]);
+  const int count = turns(upto - t_, times.data(), static_cast<int>(times.size()));
+  bool skip = count >= 0 && !keep(measured(p_, at(0))) && !keep(measured(p_, at(upto - t_)));
+  for (int i = 0; skip && i < count; ++i) skip = !keep(measured(p_, at(times[i])));
   if (skip) recorder_.skip(upto);
-  else recorder_.record(t_, upto, at);
+  else recorder_.record_last_outside(t_, upto, at, keep, last);
 }
 
 // A return to the face just left, found within the search's resolution of the certified
@@ -577,21 +582,20 @@ std::optional<SimulationStatus> ClosedFormRun::impact(const detail::GapEvent& ev
   return std::nullopt;
 }
 
-// options.sample_band moved by −shift into the run's frame and narrowed on each side by its margin: four
-// times the gate's tolerance scaled like the gate's errors, max(1, |θ|) in either frame
-// (covering the evaluator's error at a sample and at a turn, and the rounding of the shift).
-std::optional<SimulationOptions::SampleBand> narrowed_band(const ValidatedEvaluator& evaluator,
-                                                           const SimulationOptions& options, double shift) {
+// options.sample_band moved by −shift into the run's frame, and its margin: four times the gate's
+// tolerance scaled like the gate's errors, max(1, |θ|) in either frame (covering the evaluator's
+// error at a sample and at a turn, and the rounding of the shift).
+std::optional<Band> band_in_frame(const ValidatedEvaluator& evaluator, const SimulationOptions& options, double shift) {
   if (!options.sample_band) return std::nullopt;
   const auto [low, high] = *options.sample_band;
   const double margin = 4 * evaluator.report().tolerance *
                         std::max({1.0, std::fabs(low), std::fabs(high), std::fabs(low - shift), std::fabs(high - shift)});
-  return SimulationOptions::SampleBand{low - shift + margin, high - shift - margin};
+  return Band{low - shift, high - shift, margin};
 }
 
 SimulationResult simulate_as_given(const ValidatedEvaluator& evaluator, const HybridState& start,
                                    const SimulationOptions& options, std::optional<double> start_gap,
-                                   std::optional<SimulationOptions::SampleBand> band) {
+                                   std::optional<Band> band) {
   return ClosedFormRun(evaluator, start, options, start_gap, band).run();
 }
 
@@ -610,7 +614,7 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
                                               ? std::optional<double>(start.theta_L - start.theta_m)
                                               : std::nullopt;
   const std::optional<ValidatedEvaluator> centred = in_error_coordinates(evaluator);
-  if (!centred) return simulate_as_given(evaluator, start, options, start_gap, narrowed_band(evaluator, options, 0));
+  if (!centred) return simulate_as_given(evaluator, start, options, start_gap, band_in_frame(evaluator, options, 0));
   const double R = evaluator.parameters().theta_R;
   HybridState from = start;
   shift_state(from, -R);
@@ -634,7 +638,7 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
       shift_sample(moved);
       options.sample_sink(moved);
     };
-  SimulationResult r = simulate_as_given(*centred, from, shifted, start_gap, narrowed_band(evaluator, options, R));
+  SimulationResult r = simulate_as_given(*centred, from, shifted, start_gap, band_in_frame(evaluator, options, R));
   for (SimulationEvent& e : r.events) {
     e.theta_o += R;
     shift_state(e.after, R);
