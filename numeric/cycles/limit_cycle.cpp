@@ -137,22 +137,33 @@ struct NewtonResult {
   HalfCycle half;
 };
 
+// Whether Newton's next step is expected to be its last (below 1e-13 v): quadratic convergence,
+// s_{k+1} ≈ C s_k² with C = s_k / s_{k−1}² from the last two steps (1/v after one step).  Only
+// then is the half cycle computed with its extremes (the result needs them at the last v alone;
+// a wrong guess costs one more half cycle, never a different answer).
+bool expect_last(double v, double step, double step_before) {
+  const double C = std::isfinite(step_before) ? step / (step_before * step_before) : 1 / v;
+  return C * step * step <= 1e-13 * v;
+}
+
 // Newton's method on h(v) = g(v) − v from `guess`, g' from the closed forms: v* when the steps
 // settle (the last one below 1e-13 v, or at the noise floor of g below 1e-11 v) on a stable
 // fixed point (|g'| < 1) within [guess/4, 4·guess]; nothing otherwise (the caller surveys).
 std::optional<NewtonResult> newton_fixed_point(const ValidatedEvaluator& evaluator, double guess) {
-  double v = guess, previous_step = INFINITY;
+  double v = guess, previous_step = INFINITY, step_before = INFINITY;
   for (int i = 0; i < 16; ++i) {
-    HalfCycle h = half_cycle(evaluator, v, previous_step <= 1e-5 * v);
+    const bool extremes = std::isfinite(previous_step) && expect_last(v, previous_step, step_before);
+    HalfCycle h = half_cycle(evaluator, v, extremes);
     const std::optional<double> d = closed_form_derivative(evaluator, h);
     if (!d || !(*d < 1)) return std::nullopt;
     const double step = (h.v_out - v) / (*d - 1);
     const double size = std::fabs(step);
     if (size <= 1e-13 * v || (size <= 1e-11 * v && size >= 0.5 * previous_step)) {
       if (!(std::fabs(*d) < 1) || !(h.duration > 0)) return std::nullopt;
-      if (!(previous_step <= 1e-5 * v)) h = half_cycle(evaluator, v, true);
+      if (!extremes) h = half_cycle(evaluator, v, true);
       return NewtonResult{v, *d, std::move(h)};
     }
+    step_before = previous_step;
     previous_step = size;
     v -= step;
     if (!(v > guess / 4 && v < 4 * guess)) return std::nullopt;

@@ -6,6 +6,7 @@
 #include "backlash/numeric/segment_dynamics.hpp"
 #include "hybrid/gap_events.hpp"
 #include "hybrid/rest_search.hpp"
+#include "hybrid/sample_band.hpp"
 
 #include <boost/math/tools/roots.hpp>
 
@@ -137,6 +138,12 @@ class Flight {
     return f;
   }
   HybridState at(double tau) const { return free_state_of(vector(tau), face_); }
+  /// The turns of θo in (0, duration) (sample_band.hpp); −1 after a bounce (no closed form of them).
+  int turns(const Parameters& p, double duration, double* out, int capacity) const {
+    if (linear_) return -1;
+    if (p.measured_at == model::MeasuredAt::Load) return 0;  // θ̇L = θ̇m0·e^{−(FL/JL)τ}: monotone
+    return detail::damped_turns(p.Fm / (2 * p.Jm), p.K / p.Jm, evaluator_->cot_phi() * v_, v_, duration, out, capacity);
+  }
   SmallVector vector(double tau) const { return gap_sample(tau, false).x; }
   /// x(τ) and the gap change Δx(τ): one closed-form evaluation (`with_gap` false: x alone).
   WitnessSample gap_sample(double tau, bool with_gap = true) const {
@@ -270,6 +277,11 @@ HybridState rigid_start(const Parameters& p, const HybridState& start) {
 
 namespace {
 
+// A sample band (SimulationOptions::sample_band) in a run's frame, and its margin.
+struct Band {
+  double low, high, margin;
+};
+
 // One run of the closed-form hybrid automaton from a start state: contact segments (the
 // validated closed form, separation at the first certified zero of Tc) and free flights (the
 // first certified gap event), joined by the impact law.
@@ -277,8 +289,9 @@ class ClosedFormRun {
  public:
   /// `start_gap`: the gap x = θL − θm of a free start strictly inside the backlash, computed
   /// before any shift of the angles (simulate); none for every other start.
+  /// `band`: options.sample_band in this run's frame, with its margin.
   ClosedFormRun(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options,
-                std::optional<double> start_gap)
+                std::optional<double> start_gap, std::optional<Band> band)
       : evaluator_(evaluator),
         p_(evaluator.parameters()),
         o_(options),
@@ -292,7 +305,8 @@ class ClosedFormRun {
                             std::max(1.0, std::fabs(p_.theta_R))),
         rigid_(p_.backlash <= 0),  // a rigid drive: contact for ever, no events
         state_(rigid_ ? rigid_start(p_, start) : start),
-        start_gap_(rigid_ || start.in_contact ? std::nullopt : start_gap) {
+        start_gap_(rigid_ || start.in_contact ? std::nullopt : start_gap),
+        band_(band) {
     if (o_.track_extremes) {
       const double unit = servo_time_unit(p_);
       contact_velocity_.emplace(velocity_mode(contact_segment_, 1, unit));
@@ -351,6 +365,8 @@ class ClosedFormRun {
   SimulationStatus rest(const Flight& flight, double remaining, const HybridState& end);
   std::optional<SimulationStatus> impact(const detail::GapEvent& event, const HybridState& before);
   std::optional<std::string> unresolved_return(const detail::GapEvent& event) const;
+  template <class At>
+  void record(double upto, const At& at, FunctionRef<int(double, double*, int)> turns);
 
   const ValidatedEvaluator& evaluator_;
   const Parameters& p_;
@@ -368,6 +384,7 @@ class ClosedFormRun {
   const bool rigid_;
   HybridState state_;
   std::optional<double> start_gap_;  // the first flight's gap x(0) when it starts inside the backlash
+  const std::optional<Band> band_;  // options.sample_band in this run's frame (band_in_frame)
   double t_ = 0;
   ImpactWindow impacts_;
   long separations_ = 0;
@@ -439,13 +456,16 @@ std::optional<SimulationStatus> ClosedFormRun::contact() {
     const auto vector = [this, theta0, omega0](double tau) { return torque_sample(tau, theta0, omega0).x; };
     segment_extremes(p_, &*contact_velocity_, 1, vector, at, separated ? separated->t : remaining, result_.extremes);
   }
+  const auto turns = [this, theta0, omega0](double duration, double* out, int capacity) {
+    return detail::damped_turns((p_.Fm + p_.FL) / (2 * (p_.Jm + p_.JL)), p_.K / (p_.Jm + p_.JL), theta0 - p_.theta_R,
+                                omega0, duration, out, capacity);
+  };
+  record(separated ? t_ + separated->t + 1e-12 : o_.t_end + 1e-12, at, turns);
   if (!separated) {
-    recorder_.record(t_, o_.t_end + 1e-12, at);
     state_ = at(remaining);
     t_ = o_.t_end;
     return SimulationStatus::Completed;
   }
-  recorder_.record(t_, t_ + separated->t + 1e-12, at);
   const HybridState at_separation = at(separated->t);
   t_ += separated->t;
   state_ = at_separation;
@@ -473,8 +493,11 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
     const auto vector = [&flight](double tau) { return flight.vector(tau); };
     segment_extremes(p_, free_velocities_->data(), 2, vector, at, event ? event->crossing.t : remaining, result_.extremes);
   }
+  const auto turns = [this, &flight](double duration, double* out, int capacity) {
+    return flight.turns(p_, duration, out, capacity);
+  };
   if (!event) {
-    recorder_.record(t_, o_.t_end + 1e-12, at);
+    record(o_.t_end + 1e-12, at, turns);
     const HybridState end = flight.at(remaining);
     const double speed = std::max(std::fabs(end.dtheta_m), std::fabs(end.dtheta_L));
     if (speed < o_.rest_velocity) return rest(flight, remaining, end);
@@ -486,10 +509,28 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
     result_.stop_reason = std::move(*problem);
     return SimulationStatus::Unresolved;
   }
-  recorder_.record(t_, t_ + event->crossing.t + 1e-12, at);
+  record(t_ + event->crossing.t + 1e-12, at, turns);
   const HybridState before = flight.at(event->crossing.t);
   t_ += event->crossing.t;
   return impact(*event, before);
+}
+
+// The samples of a segment (its state `at(τ)`, τ = t − t_) at the times ≤ upto; with a sample band
+// (SimulationOptions::sample_band) none when its θo on [0, upto − t_] certainly lies in the band (at
+// both ends and at its turns, `turns`: sample_band.hpp, inside by the margin), else those the last
+// sample outside needs (TrajectoryRecorder::record_last_outside).
+template <class At>
+void ClosedFormRun::record(double upto, const At& at, FunctionRef<int(double, double*, int)> turns) {
+  if (!band_) return recorder_.record(t_, upto, at);
+  const Band& b = *band_;
+  const auto keep = [&b](double o) { return !(o >= b.low + b.margin && o <= b.high - b.margin); };
+  const auto last = [&b](double o) { return o < b.low - b.margin || o > b.high + b.margin; };
+  std::array<double, 8> times;
+  const int count = turns(upto - t_, times.data(), static_cast<int>(times.size()));
+  bool skip = count >= 0 && !keep(measured(p_, at(0))) && !keep(measured(p_, at(upto - t_)));
+  for (int i = 0; skip && i < count; ++i) skip = !keep(measured(p_, at(times[i])));
+  if (skip) recorder_.skip(upto);
+  else recorder_.record_last_outside(t_, upto, at, keep, last);
 }
 
 // A return to the face just left, found within the search's resolution of the certified
@@ -541,9 +582,21 @@ std::optional<SimulationStatus> ClosedFormRun::impact(const detail::GapEvent& ev
   return std::nullopt;
 }
 
+// options.sample_band moved by −shift into the run's frame, and its margin: four times the gate's
+// tolerance scaled like the gate's errors, max(1, |θ|) in either frame (covering the evaluator's
+// error at a sample and at a turn, and the rounding of the shift).
+std::optional<Band> band_in_frame(const ValidatedEvaluator& evaluator, const SimulationOptions& options, double shift) {
+  if (!options.sample_band) return std::nullopt;
+  const auto [low, high] = *options.sample_band;
+  const double margin = 4 * evaluator.report().tolerance *
+                        std::max({1.0, std::fabs(low), std::fabs(high), std::fabs(low - shift), std::fabs(high - shift)});
+  return Band{low - shift, high - shift, margin};
+}
+
 SimulationResult simulate_as_given(const ValidatedEvaluator& evaluator, const HybridState& start,
-                                   const SimulationOptions& options, std::optional<double> start_gap) {
-  return ClosedFormRun(evaluator, start, options, start_gap).run();
+                                   const SimulationOptions& options, std::optional<double> start_gap,
+                                   std::optional<Band> band) {
+  return ClosedFormRun(evaluator, start, options, start_gap, band).run();
 }
 
 void shift_state(HybridState& s, double offset) {
@@ -561,7 +614,7 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
                                               ? std::optional<double>(start.theta_L - start.theta_m)
                                               : std::nullopt;
   const std::optional<ValidatedEvaluator> centred = in_error_coordinates(evaluator);
-  if (!centred) return simulate_as_given(evaluator, start, options, start_gap);
+  if (!centred) return simulate_as_given(evaluator, start, options, start_gap, band_in_frame(evaluator, options, 0));
   const double R = evaluator.parameters().theta_R;
   HybridState from = start;
   shift_state(from, -R);
@@ -585,7 +638,7 @@ SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState
       shift_sample(moved);
       options.sample_sink(moved);
     };
-  SimulationResult r = simulate_as_given(*centred, from, shifted, start_gap);
+  SimulationResult r = simulate_as_given(*centred, from, shifted, start_gap, band_in_frame(evaluator, options, R));
   for (SimulationEvent& e : r.events) {
     e.theta_o += R;
     shift_state(e.after, R);

@@ -31,7 +31,9 @@
 
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace backlash::numeric {
@@ -101,6 +103,19 @@ struct SimulationOptions {
   double zeno_window = 0;
   long stop_after_separations = 0;  ///< > 0: stop (status completed) right after this many separations
   bool track_extremes = false;      ///< record the exact extremes of θo, θm, θL (zeros of the velocities)
+  /// Set (θo in the caller's frame): for a caller that needs only the last sample outside
+  /// [low, high] (settle.hpp), the closed-form simulator leaves out samples (counted in
+  /// SimulationResult::samples_left_out): all of a segment whose θo at its ends and at its turns
+  /// (the zeros of θ̇o, in closed form: hybrid/sample_band.hpp) lies inside the band by a margin
+  /// of four times the evaluator's validated tolerance (scaled like the gate's: max(1, |θ|)); of
+  /// the other segments, those inside by the margin and those before the segment's last sample
+  /// outside by the margin (found from its end backwards).  So the last sample outside the band,
+  /// and every sample within the margin of its edges, reach the sink, in time order, each with
+  /// its own time, as computed without the band.  Other simulators ignore it.
+  struct SampleBand {
+    double low, high;
+  };
+  std::optional<SampleBand> sample_band;
 };
 
 /// Exact extremes over the simulated time: at event states and at the certified
@@ -120,6 +135,7 @@ struct SimulationResult {
   std::vector<TrajectorySample> samples;  ///< (without a sample_sink)
   Extremes extremes;  ///< when options.track_extremes
   std::string stop_reason;  ///< for an early stop (stopped_early): what happened, in words
+  long long samples_left_out = 0;  ///< samples not recorded (SimulationOptions::sample_band)
 };
 
 /// The default Zeno window in units of the fastest time scale 1/fastest_mode_rate(p)
@@ -165,6 +181,35 @@ class TrajectoryRecorder {
          next = static_cast<double>(++k_) * o_.sample_interval)
       push(next, at(next - t0));
   }
+  /// Passes over the sample times ≤ t_upto without recording them (SimulationOptions::sample_band).
+  void skip(double t_upto) {
+    if (!o_.sample_times.empty()) {
+      for (; index_ < o_.sample_times.size() && o_.sample_times[index_] <= t_upto; ++index_) ++r_.samples_left_out;
+      return;
+    }
+    if (o_.sample_interval <= 0) return;
+    for (; static_cast<double>(k_) * o_.sample_interval <= t_upto; ++k_) ++r_.samples_left_out;
+  }
+  /// record() for a caller that needs only the last θo outside a band (SimulationOptions::sample_band):
+  /// the samples from the segment's last backwards, keeping those `keep(θo)` says may be outside
+  /// and stopping at the first `last(θo)` says is certainly outside; the kept ones are recorded in
+  /// time order, the others counted as left out.  With sample_times: record().
+  template <class At, class Keep, class Last>
+  void record_last_outside(double t0, double t_upto, const At& at, const Keep& keep, const Last& last) {
+    if (!o_.sample_times.empty() || o_.sample_interval <= 0) return record(t0, t_upto, at);
+    const long long first = k_;
+    while (static_cast<double>(k_) * o_.sample_interval <= t_upto) ++k_;
+    kept_.clear();
+    for (long long k = k_ - 1; k >= first; --k) {
+      const double t = static_cast<double>(k) * o_.sample_interval;
+      const HybridState h = at(t - t0);
+      if (!keep(measured(p_, h))) continue;
+      kept_.push_back({t, h});
+      if (last(measured(p_, h))) break;
+    }
+    r_.samples_left_out += (k_ - first) - static_cast<long long>(kept_.size());
+    for (auto it = kept_.rbegin(); it != kept_.rend(); ++it) push(it->first, it->second);
+  }
 
  private:
   void push(double t, const HybridState& h) {
@@ -178,6 +223,7 @@ class TrajectoryRecorder {
   SimulationResult& r_;
   long long k_ = 0;
   std::size_t index_ = 0;
+  std::vector<std::pair<double, HybridState>> kept_;  // record_last_outside's, reused
 };
 
 /// The state with the measured shaft at θo, both shafts moving at `velocity`, and the
