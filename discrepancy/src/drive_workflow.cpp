@@ -3,7 +3,9 @@
 // checked over windows restarted from the measured state.
 #include "backlash/discrepancy/measured_drive.hpp"
 
+#include "drive_internal.hpp"
 #include "quiet_ceres.hpp"
+#include "two_body_signals.hpp"
 
 #include "backlash/measurements/inverse_dynamics_signals.hpp"
 #include "backlash/discrepancy/measured_drive_simulation.hpp"
@@ -87,13 +89,7 @@ struct Prepared {
   bool compared(std::size_t k) const { return in[k] != 0; }
 };
 
-struct Band {
-  measurements::ButterworthLowPass filter;
-  double cutoff = 0, floor = NAN;
-  bool from_spectrum = true;
-  double rest_speed = 0;
-  std::size_t edge = 0;  // samples left out at each end of a record
-};
+using Band = detail::DriveBand;
 
 // The filter's effective length: the smallest m such that the zero-phase impulse response
 // outside ±m samples holds at most 10⁻⁴ of its absolute sum — the end transients of the
@@ -710,11 +706,13 @@ void check_drive_inputs(const model::CaseSpec& spec, const std::string& where, c
                         const measurements::MeasuredRecord* validation) {
   if (!spec.experiment || spec.experiment->kind != model::ExperimentKind::Drive)
     throw std::invalid_argument(where + ": the model's [experiment] is not a measured drive (kind = \"drive\")");
-  if (spec.backlash != 0)
-    throw std::invalid_argument(where + ": backlash: a measured-drive model is a rigid drive (backlash 0); a drive with a gap and a logged drive is not supported");
   if (!data.drive) throw std::invalid_argument(data.source.string() + ": no drive column: a measured-drive model needs the logged drive");
   if (validation && !validation->drive)
     throw std::invalid_argument(validation->source.string() + ": no drive column: a measured-drive model needs the logged drive");
+  for (const measurements::MeasuredRecord* record : {&data, validation})
+    if (record && record->theta_out.size() != record->size())
+      throw std::invalid_argument(record->source.string() +
+                                  ":1: theta_out: missing column: a rigid drive's record gives the measured shaft (t, theta_out, drive)");
 }
 
 // The free nominal parameters: on a rigid drive only J and F show (the names as given, with
@@ -1006,10 +1004,22 @@ std::size_t samples_before(const measurements::MeasuredRecord& data, double t_en
 
 }  // namespace
 
+detail::DriveBand detail::drive_band(const std::vector<double>& q, const std::vector<double>& u, double fs,
+                                     const DriveOptions& options, DriveDiscrepancyResult& result) {
+  return band_of(q, u, fs, options, result);
+}
+
 DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const measurements::MeasuredRecord& data,
                                               const DriveOptions& options, const measurements::MeasuredRecord* validation) {
   const auto started = std::chrono::steady_clock::now();
   const std::string where = spec.source.filename().string();
+  if (spec.experiment && spec.experiment->kind == model::ExperimentKind::Drive && spec.backlash != 0) {
+    if (validation)
+      throw std::invalid_argument(validation->source.string() + ": a validation record is not yet scored on a drive with a gap (backlash > 0)");
+    DriveDiscrepancyResult result = two_body::find(spec, data, options);
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    return result;
+  }
   check_drive_inputs(spec, where, data, validation);
   const double gain = model::to_double(spec.experiment->drive_gain);
   const double t_end = spec.experiment->t_end ? model::to_double(*spec.experiment->t_end) : INFINITY;
