@@ -27,4 +27,8 @@ struct DriveBand {
 DriveBand drive_band(const std::vector<double>& q, const std::vector<double>& u, double fs, const DriveOptions& options,
                      DriveDiscrepancyResult& result);
 
+/// The filter's effective length [samples] (its impulse response outside ±m holds at most 10⁻⁴
+/// of its absolute sum), plus two for the difference stencils.
+std::size_t drive_filter_edge(const measurements::ButterworthLowPass& filter);
+
 }  // namespace backlash::discrepancy::detail

@@ -1009,6 +1009,8 @@ detail::DriveBand detail::drive_band(const std::vector<double>& q, const std::ve
   return band_of(q, u, fs, options, result);
 }
 
+std::size_t detail::drive_filter_edge(const measurements::ButterworthLowPass& filter) { return edge_samples(filter); }
+
 DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const measurements::MeasuredRecord& data,
                                               const DriveOptions& options, const measurements::MeasuredRecord* validation) {
   const auto started = std::chrono::steady_clock::now();

@@ -23,6 +23,27 @@ namespace {
 
 constexpr double kNoiseFactor = 1.15;  // as the rigid workflow's: a residual within it is noise
 
+}  // namespace
+
+void filter_signals(Signals& s, const measurements::ButterworthLowPass& filter, std::size_t edge) {
+  const std::size_t n = s.size();
+  s.filter = filter;
+  s.reach = edge + 2;
+  s.begin = std::min(edge, n / 4);
+  s.end = n - s.begin;
+  s.qmf = measurements::zero_phase_filter(s.qm, s.filter);
+  const measurements::Derivatives d = measurements::derivatives(s.qmf, s.fs);
+  s.vm = d.velocity;
+  s.am = d.acceleration;
+  s.sm = signs_of(s.qm, s.vm, s.rest_speed, true);
+  s.sm_f = measurements::zero_phase_filter(std::vector<double>(s.sm.begin(), s.sm.end()), s.filter);
+  std::vector<double> held(n);
+  for (std::size_t k = 0; k < n; ++k) held[k] = 0.5 * (s.u[k] + s.u[k == 0 ? 0 : k - 1]);  // the zero-order hold's average
+  s.Uf = measurements::zero_phase_filter(held, s.filter);
+}
+
+namespace {
+
 // The record: uniform sampling, the band (the cut-off from the motor position's spectrum unless
 // given), the filtered motor signals and the held drive.
 Signals prepare(const model::CaseSpec& spec, const measurements::MeasuredRecord& data, const DriveOptions& options,
@@ -46,20 +67,16 @@ Signals prepare(const model::CaseSpec& spec, const measurements::MeasuredRecord&
     throw std::invalid_argument(data.source.string() + ": t: " + error.what());
   }
   const detail::DriveBand band = detail::drive_band(s.qm, s.u, s.fs, options, result);
-  s.filter = band.filter;
   s.rest_speed = band.rest_speed;
-  s.reach = band.edge + 2;
-  s.begin = std::min(band.edge, n / 4);
-  s.end = n - s.begin;
-  s.qmf = measurements::zero_phase_filter(s.qm, s.filter);
-  const measurements::Derivatives d = measurements::derivatives(s.qmf, s.fs);
-  s.vm = d.velocity;
-  s.am = d.acceleration;
-  s.sm = signs_of(s.qm, s.vm, s.rest_speed, true);
-  s.sm_f = measurements::zero_phase_filter(std::vector<double>(s.sm.begin(), s.sm.end()), s.filter);
-  std::vector<double> held(n);
-  for (std::size_t k = 0; k < n; ++k) held[k] = 0.5 * (s.u[k] + s.u[k == 0 ? 0 : k - 1]);  // the zero-order hold's average
-  s.Uf = measurements::zero_phase_filter(held, s.filter);
+  if (s.qL.empty() && !std::isfinite(options.cutoff)) {
+    // The motor encoder alone: the load observer's contact is rigid, which holds below the mesh's
+    // resonance; the band is cut at a quarter of the spectrum's cut-off (docs/discrepancy.md).
+    result.cutoff = band.cutoff / 4;
+    const measurements::ButterworthLowPass filter = measurements::design_butterworth_low_pass(result.cutoff, s.fs);
+    filter_signals(s, filter, detail::drive_filter_edge(filter));
+    return s;
+  }
+  filter_signals(s, band.filter, band.edge);
   return s;
 }
 
@@ -319,66 +336,172 @@ std::vector<std::size_t> observer_samples(const Signals& s) {
   return out;
 }
 
-// The profiled cost at gap b: the observer and the least squares alternated three times.
-LinearFit profile(const Signals& s, double b, const Theta& start, const FreeSet& free, const std::vector<std::size_t>& samples) {
-  LinearFit best;
+// The observer depends on the load only through its shape: the gap b and the decelerations per
+// unit velocity α = FL/JL and per unit inertia β = TL/JL.  For a shape, the residual is linear in
+// JL (the load's column aL + α·v̂L + β·s̄L) and in the motor's free parameters: variable projection.
+struct Shape {
+  double b = 0, alpha = 0, beta = 0;
+};
+
+LoadSide tied_load(const Signals& s, const Shape& z) {
+  const std::vector<double> x = load_observer(s.qmf, s.vm, s.am, s.fs, z.b, 0, 1, z.alpha, z.beta);
+  std::vector<double> qL(s.size());
+  for (std::size_t k = 0; k < s.size(); ++k) qL[k] = s.qm[k] + x[k];
+  LoadSide l = load_side(s, std::move(qL), false);
+  for (std::size_t k = 0; k < s.size(); ++k) l.aL[k] += z.alpha * l.vL[k] + z.beta * l.sL_f[k], l.vL[k] = 0, l.sL_f[k] = 0;
+  return l;
+}
+
+LinearFit shape_fit(const Signals& s, const Shape& z, const Theta& start, FreeSet free, const std::vector<std::size_t>& samples) {
   Theta m = start;
-  for (int iteration = 0; iteration < 3; ++iteration) {
-    const LinearFit l = solve(s, observed_load(s, b, m), m, free, samples);
-    if (!l.ok) break;
-    if (l.sse < best.sse) best = l;
-    m = l.m;
-  }
-  return best;
+  m[kFL] = m[kTL] = 0;
+  free[kJL] = true, free[kFL] = free[kTL] = false;
+  LinearFit f = solve(s, tied_load(s, z), m, free, samples);
+  if (f.ok) f.m[kFL] = z.alpha * f.m[kJL], f.m[kTL] = z.beta * f.m[kJL];
+  return f;
 }
 
 struct ObserverFit {
-  double b = 0, sigma_b = NAN;
+  Shape z;
+  double sigma_b = NAN;
   Theta m{};
   double sse = INFINITY, sse_rigid = INFINITY;
 };
 
-// b by a scan (0 and 40 logarithmic points from the encoder's step to half the motor's travel)
-// and Brent's minimisation in the best point's bracket.
-ObserverFit fit_observer(const Signals& s, const Theta& start, const FreeSet& free, const std::vector<std::size_t>& samples) {
+// One coordinate of the shape by a scan of `grid` and Brent's minimisation in the best bracket.
+void coordinate(const Signals& s, ObserverFit& f, double Shape::*which, const std::vector<double>& grid, const FreeSet& free,
+                const std::vector<std::size_t>& samples) {
+  auto cost = [&](double value) {
+    Shape z = f.z;
+    z.*which = value;
+    return shape_fit(s, z, f.m, free, samples);
+  };
+  std::size_t arg = grid.size();
+  for (std::size_t j = 0; j < grid.size(); ++j) {
+    const LinearFit l = cost(grid[j]);
+    if (l.ok && l.sse < f.sse) f.sse = l.sse, f.m = l.m, f.z.*which = grid[j], arg = j;
+  }
+  if (arg == grid.size()) {  // the current point stays the best: refine around it
+    arg = static_cast<std::size_t>(std::lower_bound(grid.begin(), grid.end(), f.z.*which) - grid.begin());
+    arg = std::min(arg, grid.size() - 1);
+  }
+  const double lo = grid[arg == 0 ? 0 : arg - 1], hi = grid[std::min(arg + 1, grid.size() - 1)];
+  if (!(hi > lo)) return;
+  const auto [x, c] = boost::math::tools::brent_find_minima([&](double v) { const LinearFit l = cost(v); return l.ok ? l.sse : INFINITY; }, lo, hi, 30);
+  const LinearFit l = cost(x);
+  if (l.ok && l.sse < f.sse) f.sse = l.sse, f.m = l.m, f.z.*which = x;
+  (void)c;
+}
+
+// The grids of the shape's coordinates.  Wide (the first, coarsest band): b over 0 and 40
+// logarithmic points from the encoder's step to half the motor's travel, α and β over
+// [0, 4·A/V] and [0, 4·A] (A, V the 90th percentiles of |âm| and |v̂m|).  Narrow (the finer
+// bands): 0 and 13 points from 1/1.5 to 1.5 times the current b, from 1/5 to 5 times α and β.
+struct Grids {
+  std::vector<double> b, alpha, beta;
+};
+
+std::vector<double> around(double x, double factor) {
+  std::vector<double> g{0};
+  if (x > 0)
+    for (int j = -6; j <= 6; ++j) g.push_back(x * std::pow(factor, j / 6.0));
+  return g;
+}
+
+Grids grids_of(const Signals& s, const Shape& z, bool wide) {
+  if (!wide) return {around(z.b, 1.5), around(z.alpha, 5), around(z.beta, 5)};
   double step = INFINITY, lo = INFINITY, hi = -INFINITY;
+  std::vector<double> A, V;
   for (std::size_t k = 0; k < s.size(); ++k) {
     lo = std::min(lo, s.qm[k]), hi = std::max(hi, s.qm[k]);
     if (k > 0 && s.qm[k] != s.qm[k - 1]) step = std::min(step, std::fabs(s.qm[k] - s.qm[k - 1]));
+    A.push_back(std::fabs(s.am[k])), V.push_back(std::fabs(s.vm[k]));
   }
+  std::nth_element(A.begin(), A.begin() + static_cast<std::ptrdiff_t>(9 * A.size() / 10), A.end());
+  std::nth_element(V.begin(), V.begin() + static_cast<std::ptrdiff_t>(9 * V.size() / 10), V.end());
+  const double a90 = A[9 * A.size() / 10], v90 = std::max(V[9 * V.size() / 10], 1e-300);
   const double b_lo = std::isfinite(step) ? step : 1e-6 * (hi - lo), b_hi = 0.5 * (hi - lo);
-  std::vector<double> grid{0};
-  for (int j = 0; j <= 40; ++j) grid.push_back(b_lo * std::pow(b_hi / b_lo, j / 40.0));
-  ObserverFit out;
-  std::size_t arg = 0;
-  for (std::size_t j = 0; j < grid.size(); ++j) {
-    const LinearFit l = profile(s, grid[j], start, free, samples);
-    if (j == 0) out.sse_rigid = l.sse;
-    if (l.ok && l.sse < out.sse) out.sse = l.sse, out.b = grid[j], out.m = l.m, arg = j;
+  Grids g;
+  g.b.push_back(0);
+  for (int j = 0; j <= 40; ++j) g.b.push_back(b_lo * std::pow(b_hi / b_lo, j / 40.0));
+  for (int j = 0; j <= 16; ++j) g.alpha.push_back(4 * a90 / v90 * j / 16.0), g.beta.push_back(4 * a90 * j / 16.0);
+  return g;
+}
+
+// The shape by coordinate descent from `f` (three sweeps over b, α, β; β only with `coulomb_load`).
+void fit_shape(const Signals& s, ObserverFit& f, const FreeSet& free, bool coulomb_load, bool wide,
+               const std::vector<std::size_t>& samples) {
+  const Grids g = grids_of(s, f.z, wide);
+  f.sse = shape_fit(s, f.z, f.m, free, samples).sse;
+  for (int sweep = 0; sweep < 3; ++sweep) {
+    coordinate(s, f, &Shape::b, g.b, free, samples);
+    coordinate(s, f, &Shape::alpha, g.alpha, free, samples);
+    if (coulomb_load) coordinate(s, f, &Shape::beta, g.beta, free, samples);
   }
-  if (!std::isfinite(out.sse)) return out;
-  const double a = grid[arg == 0 ? 0 : arg - 1], c = grid[std::min(arg + 1, grid.size() - 1)];
-  const auto [b, cost] = boost::math::tools::brent_find_minima(
-      [&](double value) { return profile(s, value, out.m, free, samples).sse; }, a, c, 30);
-  if (cost < out.sse) {
-    const LinearFit l = profile(s, b, out.m, free, samples);
-    if (l.ok) out.sse = l.sse, out.b = b, out.m = l.m;
+  Shape rigid = f.z;
+  rigid.b = 0;
+  f.sse_rigid = shape_fit(s, rigid, f.m, free, samples).sse;
+}
+
+// The shape polished by Levenberg–Marquardt (Ceres, numeric derivatives through the observer and
+// the projection): the coordinate scans find the valley, this follows it (b and the load's
+// Coulomb friction trade against each other along it).
+void polish_shape(const Signals& s, ObserverFit& f, const FreeSet& free, bool coulomb_load, const std::vector<std::size_t>& samples) {
+  std::vector<double> x{f.z.b, f.z.alpha, f.z.beta};
+  if (!coulomb_load) x.pop_back();
+  const Theta start = f.m;
+  const std::function<void(const double*, double*)> residual = [&](const double* p, double* r) {
+    const Shape z{std::max(0.0, p[0]), std::max(0.0, p[1]), coulomb_load ? std::max(0.0, p[2]) : 0.0};
+    const LinearFit l = shape_fit(s, z, start, free, samples);
+    Theta m = l.m;
+    m[kFL] = m[kTL] = 0;
+    const std::vector<double> all = l.ok ? residuals(s, tied_load(s, z), m) : std::vector<double>(s.size(), 1e3);
+    for (std::size_t i = 0; i < samples.size(); ++i) r[i] = all[samples[i]];
+  };
+  ceres_sigma(residual, samples.size(), x, std::vector<double>(x.size(), 0.0), true, 1e-3);
+  const Shape z{x[0], x[1], coulomb_load ? x[2] : 0.0};
+  const LinearFit l = shape_fit(s, z, start, free, samples);
+  if (l.ok && l.sse < f.sse) f.z = z, f.m = l.m, f.sse = l.sse;
+}
+
+// Coarse to fine: the profiled cost of a wrong gap is the mismatch of the impacts' timing, whose
+// basin is as wide as the filter's impulse response; so the shape is found in the band cut at
+// 1/8 of the cut-off first, then refined at 1/4, 1/2 and the cut-off itself.
+ObserverFit fit_shape_coarse_to_fine(const Signals& s, const Theta& start, const FreeSet& free, bool coulomb_load,
+                                     const std::vector<std::size_t>& samples) {
+  ObserverFit f;
+  f.m = start;
+  f.z = {0, start[kFL] / start[kJL], start[kTL] / start[kJL]};
+  for (int level = 3; level >= 0; --level) {
+    Signals coarse = s;
+    const double cutoff = s.filter.cutoff_hz / std::pow(2.0, level);
+    if (level > 0) {
+      const measurements::ButterworthLowPass filter = measurements::design_butterworth_low_pass(cutoff, s.fs);
+      filter_signals(coarse, filter, detail::drive_filter_edge(filter));
+    }
+    const std::vector<std::size_t> inner = level > 0 ? observer_samples(coarse) : samples;
+    fit_shape(level > 0 ? coarse : s, f, free, coulomb_load, level == 3, inner);
+    polish_shape(level > 0 ? coarse : s, f, free, coulomb_load, inner);
   }
-  return out;
+  return f;
 }
 
 // σ of b and of the free parameters: Ceres's covariance, numeric derivatives through the observer.
-std::vector<double> observer_sigma(const Signals& s, ObserverFit& f, const FreeSet& free, const std::vector<std::size_t>& samples) {
+std::vector<double> observer_sigma(const Signals& s, ObserverFit& f, const FreeSet& free, bool coulomb_load,
+                                   const std::vector<std::size_t>& samples) {
   std::vector<int> order;
   for (int i = 0; i < kCount; ++i)
-    if (free[i]) order.push_back(i);
-  std::vector<double> x{f.b};
+    if (free[i] || i == kJL || i == kFL || (coulomb_load && i == kTL)) order.push_back(i);
+  std::vector<double> x{f.z.b};
   for (int i : order) x.push_back(f.m[i]);
   const std::function<void(const double*, double*)> residual = [&](const double* p, double* r) {
     Theta m = f.m;
     for (std::size_t j = 0; j < order.size(); ++j) m[order[j]] = p[j + 1];
-    m[kJL] = std::max(m[kJL], 1e-12 * f.m[kJL]), m[kFL] = std::max(0.0, m[kFL]), m[kTL] = std::max(0.0, m[kTL]);
-    const std::vector<double> all = residuals(s, observed_load(s, std::max(0.0, p[0]), m), m);
+    const double JL = std::max(m[kJL], 1e-12 * f.m[kJL]);
+    const Shape z{std::max(0.0, p[0]), std::max(0.0, m[kFL]) / JL, std::max(0.0, m[kTL]) / JL};
+    Theta mt = m;
+    mt[kJL] = JL, mt[kFL] = mt[kTL] = 0;
+    const std::vector<double> all = residuals(s, tied_load(s, z), mt);
     for (std::size_t i = 0; i < samples.size(); ++i) r[i] = all[samples[i]];
   };
   std::vector<double> sigma = ceres_sigma(residual, samples.size(), x, std::vector<double>(x.size(), -INFINITY), false);
@@ -530,19 +653,29 @@ void both_encoders(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   for (std::size_t k = 0; k < s.size(); ++k) two.loop_model[k] = s.qm[k] + model_gap[k];
 }
 
-// The motor encoder alone: the load observed for a trial gap; b by the profiled cost.
+// The motor encoder alone: the load observed for a trial shape; the shape by the profiled cost,
+// first with every friction and the offset free (so that the observer moves as the load does),
+// then the effects named on the observed load, then the shape again with the named ones.
 void motor_encoder(const Signals& s, const DriveOptions& options, Fitted& f, DriveDiscrepancyResult& result, TwoBodyFindings& two) {
   const std::vector<std::size_t> samples = observer_samples(s);
-  ObserverFit nominal = fit_observer(s, f.given, f.free, samples);
-  if (!std::isfinite(nominal.sse)) throw std::invalid_argument(s.name + ": the record does not fit a physical drive with the load's parameters free (JL > 0, FL >= 0)");
-  f.nominal = nominal.m;
-  const LoadSide l = observed_load(s, nominal.b, nominal.m);
+  FreeSet everything = f.free;
+  for (const auto& [effect, which] : effect_columns()) everything[which] = which != kTL && f.given[which] == 0;
+  ObserverFit first = fit_shape_coarse_to_fine(s, f.given, everything, true, samples);
+  if (!std::isfinite(first.sse)) throw std::invalid_argument(s.name + ": the record does not fit a physical drive with the load's parameters free (JL > 0, FL >= 0)");
+  Theta nominal = first.m;
+  for (int i : {kTm, kTL, kT0}) nominal[i] = f.given[i];
+  const LoadSide l = observed_load(s, first.z.b, first.m);
+  const LinearFit best_nominal = solve(s, l, nominal, f.free, samples);
+  f.nominal = best_nominal.ok ? best_nominal.m : nominal;
   Search w{s, l, samples, {}, {}, options};
   split_blocks(s, w.all, w.fit, w.holdout);
   name_effects(w, f.nominal, f.free, result);
-  ObserverFit final_fit = fit_observer(s, f.nominal, f.free, samples);
-  f.sigma = observer_sigma(s, final_fit, f.free, samples);
-  f.m = final_fit.m, f.b = final_fit.b, f.sigma_b = final_fit.sigma_b;
+  const bool coulomb_load = f.free[kTL] || f.given[kTL] > 0;
+  ObserverFit final_fit = first;
+  final_fit.m = f.nominal;
+  fit_shape(s, final_fit, f.free, coulomb_load, false, samples);
+  f.sigma = observer_sigma(s, final_fit, f.free, coulomb_load, samples);
+  f.m = final_fit.m, f.b = final_fit.z.b, f.sigma_b = final_fit.sigma_b;
   f.r_given = residuals(s, observed_load(s, f.given_b, f.given), f.given);
   f.r_nominal = residuals(s, l, f.nominal);
   f.r_after = residuals(s, observed_load(s, f.b, f.m), f.m);

@@ -141,12 +141,15 @@ struct FunctionCost {
 }  // namespace
 
 std::vector<double> ceres_sigma(const std::function<void(const double*, double*)>& residual, std::size_t n,
-                                std::vector<double>& x, const std::vector<double>& lower, bool polish) {
+                                std::vector<double>& x, const std::vector<double>& lower, bool polish, double relative_step) {
   detail::quiet_ceres();
   const std::size_t k = x.size();
   std::vector<double> sigma(k, NAN);
   if (k == 0 || n <= k) return sigma;
-  auto* cost = new ceres::DynamicNumericDiffCostFunction<FunctionCost, ceres::CENTRAL>(new FunctionCost{&residual});
+  ceres::NumericDiffOptions diff;
+  diff.relative_step_size = relative_step;
+  auto* cost = new ceres::DynamicNumericDiffCostFunction<FunctionCost, ceres::CENTRAL>(new FunctionCost{&residual},
+                                                                                       ceres::TAKE_OWNERSHIP, diff);
   cost->AddParameterBlock(static_cast<int>(k));
   cost->SetNumResiduals(static_cast<int>(n));
   ceres::Problem problem;
@@ -156,7 +159,7 @@ std::vector<double> ceres_sigma(const std::function<void(const double*, double*)
   if (polish) {
     ceres::Solver::Options options;
     options.linear_solver_type = ceres::DENSE_QR;
-    options.max_num_iterations = 10;
+    options.max_num_iterations = 30;
     options.logging_type = ceres::SILENT;
     options.num_threads = 1;
     ceres::Solver::Summary summary;

@@ -44,6 +44,10 @@ struct LoadSide {
   std::vector<signed char> sL;
 };
 
+/// The filtered motor signals and the held drive through `filter` (effective length `edge`
+/// samples: the ends and the neighbourhood of a change of sign left out by that much).
+void filter_signals(Signals& s, const measurements::ButterworthLowPass& filter, std::size_t edge);
+
 /// sgn v̂ with rest: the encoder's count unchanged over k−1, k, k+1 (when `counted`) or
 /// |v̂| ≤ rest_speed.
 std::vector<signed char> signs_of(const std::vector<double>& q, const std::vector<double>& v, double rest_speed, bool counted);
@@ -70,9 +74,10 @@ LinearFit solve(const Signals& s, const LoadSide& l, const Theta& start, const F
 
 /// Levenberg–Marquardt polish of `x` on `residual` (n residuals) and one σ per parameter:
 /// Ceres's covariance (numeric central differences) scaled by the residual variance and τ_int.
-/// `lower`: each parameter's lower bound (−∞: none).
+/// `lower`: each parameter's lower bound (−∞: none); `relative_step` of the differences.
 std::vector<double> ceres_sigma(const std::function<void(const double*, double*)>& residual, std::size_t n,
-                                std::vector<double>& x, const std::vector<double>& lower, bool polish);
+                                std::vector<double>& x, const std::vector<double>& lower, bool polish,
+                                double relative_step = 1e-6);
 
 /// The workflow (find_drive_discrepancy routes a case with backlash > 0 here).
 DriveDiscrepancyResult find(const model::CaseSpec& spec, const measurements::MeasuredRecord& data, const DriveOptions& options);
