@@ -224,19 +224,6 @@ struct GapFit {
   double contact_fraction = 0;
 };
 
-// The faces' plateaus: the samples whose gap lies within `tol` of a face's prediction (those
-// within the filter's length of a change of contact are left out by solve_gap).
-std::vector<signed char> classify(const Signals& s, const std::vector<double>& xf, const std::vector<double>& R,
-                                  const GapFit& g, double tol) {
-  const std::size_t n = s.size();
-  std::vector<signed char> face(n, 0);
-  for (std::size_t k = s.begin; k < s.end; ++k)
-    for (int sigma : {-1, 1})
-      if (std::fabs(xf[k] - (g.x0 + sigma * g.b / 2 - g.c * R[k])) <= tol)
-        face[k] = static_cast<signed char>(sigma);
-  return face;
-}
-
 bool solve_gap(const Signals& s, const std::vector<double>& xf, const std::vector<double>& R, bool compliant, GapFit& g) {
   std::vector<std::size_t> rows;
   for (std::size_t k = s.begin + s.reach; k + s.reach < s.end; ++k) {
@@ -262,26 +249,20 @@ bool solve_gap(const Signals& s, const std::vector<double>& xf, const std::vecto
   return true;
 }
 
-// Starts from the gap's two clusters (the medians above and below the middle of its range) and
-// alternates classification and least squares.
-GapFit fit_gap(const Signals& s, const std::vector<double>& xf, const std::vector<double>& R, bool compliant, double noise) {
-  std::vector<double> inner(xf.begin() + static_cast<std::ptrdiff_t>(s.begin), xf.begin() + static_cast<std::ptrdiff_t>(s.end));
-  std::sort(inner.begin(), inner.end());
-  const double lo = inner[inner.size() / 50], hi = inner[inner.size() - 1 - inner.size() / 50], mid = 0.5 * (lo + hi);
-  const auto split = std::lower_bound(inner.begin(), inner.end(), mid);
-  const double face_lo = inner[static_cast<std::size_t>(split - inner.begin()) / 2];
-  const double face_hi = inner[static_cast<std::size_t>(split - inner.begin()) + static_cast<std::size_t>(inner.end() - split) / 2];
+// Contact where it is certain: the load's inverse dynamics R is the mesh torque, 0 in flight, and
+// on face σ it is −σ·P with P > 0; so the samples whose |R| exceeds a tenth of its 95th percentile
+// are in contact on face −sgn R (those within the filter's length of a change are left out by
+// solve_gap).  b, x0 (and 1/kc) by least squares over them.
+GapFit fit_gap(const Signals& s, const std::vector<double>& xf, const std::vector<double>& R, bool compliant) {
+  std::vector<double> size;
+  for (std::size_t k = s.begin; k < s.end; ++k) size.push_back(std::fabs(R[k]));
+  std::nth_element(size.begin(), size.begin() + static_cast<std::ptrdiff_t>(95 * size.size() / 100), size.end());
+  const double threshold = 0.1 * size[95 * size.size() / 100];
   GapFit g;
-  g.x0 = 0.5 * (face_lo + face_hi), g.b = std::max(face_hi - face_lo, 0.0);
-  for (int iteration = 0; iteration < 8; ++iteration) {
-    const double tol = std::max(4 * noise, 0.05 * g.b);
-    g.face = classify(s, xf, R, g, tol);
-    GapFit next = g;
-    if (!solve_gap(s, xf, R, compliant, next)) break;
-    const bool same = std::fabs(next.b - g.b) <= 1e-6 * std::max(g.b, noise) && next.contact.size() == g.contact.size();
-    g = next;
-    if (same) break;
-  }
+  g.face.assign(s.size(), 0);
+  for (std::size_t k = s.begin; k < s.end; ++k)
+    if (std::fabs(R[k]) > threshold) g.face[k] = R[k] > 0 ? -1 : 1;
+  if (!solve_gap(s, xf, R, compliant, g)) g.sse = INFINITY;
   g.contact_fraction = static_cast<double>(g.contact.size()) / static_cast<double>(std::max<std::size_t>(1, s.end - s.begin));
   return g;
 }
@@ -624,11 +605,10 @@ void both_encoders(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   for (std::size_t k = 0; k < s.size(); ++k) x[k] = s.qL[k] - s.qm[k];
   const std::vector<double> xf = measurements::zero_phase_filter(x, s.filter);
   for (std::size_t k = 0; k < s.size(); ++k) R[k] = f.m[kJL] * l.aL[k] + f.m[kFL] * l.vL[k] + f.m[kTL] * l.sL_f[k];
-  const double noise = estimate_noise(x);
-  GapFit rigid = fit_gap(s, xf, R, false, noise);
+  GapFit rigid = fit_gap(s, xf, R, false);
   GapFit g = rigid;
   if (!std::isfinite(g.sse)) throw std::invalid_argument(s.name + ": theta_load: the gap theta_load - theta_motor shows no contact plateau to read the backlash on");
-  GapFit compliant = fit_gap(s, xf, R, true, noise);
+  GapFit compliant = fit_gap(s, xf, R, true);
   const double n_eff = static_cast<double>(rigid.contact.size()) / tau_int_on(xf, rigid.contact);
   Candidate c;
   c.effect = "compliance";
