@@ -290,8 +290,8 @@ void gap_sigma(const std::vector<double>& xf, const std::vector<double>& R, GapF
 namespace {
 
 // The load side the observer reconstructs for gap b and the load's parameters in m.
-LoadSide observed_load(const Signals& s, double b, const Theta& m) {
-  const std::vector<double> x = load_observer(s.qmf, s.vm, s.am, s.fs, b, 0, m[kJL], m[kFL], m[kTL]);
+LoadSide observed_load(const Signals& s, double b, const Theta& m, double compliance) {
+  const std::vector<double> x = load_observer(s.qmf, s.vm, s.am, s.fs, b, 0, m[kJL], m[kFL], m[kTL], compliance);
   std::vector<double> qL(s.size());
   for (std::size_t k = 0; k < s.size(); ++k) qL[k] = s.qm[k] + x[k];
   return load_side(s, std::move(qL), false);
@@ -322,10 +322,11 @@ std::vector<std::size_t> observer_samples(const Signals& s) {
 // JL (the load's column aL + α·v̂L + β·s̄L) and in the motor's free parameters: variable projection.
 struct Shape {
   double b = 0, alpha = 0, beta = 0;
+  double compliance = 0;  // 1/kc per unit load inertia (JL/kc: the observer runs with JL = 1); the file's, held
 };
 
 LoadSide tied_load(const Signals& s, const Shape& z) {
-  const std::vector<double> x = load_observer(s.qmf, s.vm, s.am, s.fs, z.b, 0, 1, z.alpha, z.beta);
+  const std::vector<double> x = load_observer(s.qmf, s.vm, s.am, s.fs, z.b, 0, 1, z.alpha, z.beta, z.compliance);
   std::vector<double> qL(s.size());
   for (std::size_t k = 0; k < s.size(); ++k) qL[k] = s.qm[k] + x[k];
   LoadSide l = load_side(s, std::move(qL), false);
@@ -432,7 +433,7 @@ void polish_shape(const Signals& s, ObserverFit& f, const FreeSet& free, bool co
   if (!coulomb_load) x.pop_back();
   const Theta start = f.m;
   const std::function<void(const double*, double*)> residual = [&](const double* p, double* r) {
-    const Shape z{std::max(0.0, p[0]), std::max(0.0, p[1]), coulomb_load ? std::max(0.0, p[2]) : 0.0};
+    const Shape z{std::max(0.0, p[0]), std::max(0.0, p[1]), coulomb_load ? std::max(0.0, p[2]) : 0.0, f.z.compliance};
     const LinearFit l = shape_fit(s, z, start, free, samples);
     Theta m = l.m;
     m[kFL] = m[kTL] = 0;
@@ -440,7 +441,7 @@ void polish_shape(const Signals& s, ObserverFit& f, const FreeSet& free, bool co
     for (std::size_t i = 0; i < samples.size(); ++i) r[i] = all[samples[i]];
   };
   ceres_sigma(residual, samples.size(), x, std::vector<double>(x.size(), 0.0), true, 1e-3);
-  const Shape z{x[0], x[1], coulomb_load ? x[2] : 0.0};
+  const Shape z{x[0], x[1], coulomb_load ? x[2] : 0.0, f.z.compliance};
   const LinearFit l = shape_fit(s, z, start, free, samples);
   if (l.ok && l.sse < f.sse) f.z = z, f.m = l.m, f.sse = l.sse;
 }
@@ -449,11 +450,12 @@ void polish_shape(const Signals& s, ObserverFit& f, const FreeSet& free, bool co
 // basin is as wide as the filter's impulse response; so the shape is found in the band cut at
 // 1/8 of the cut-off first, then refined at 1/4, 1/2 and the cut-off itself.
 ObserverFit fit_shape_coarse_to_fine(const Signals& s, const Theta& start, const FreeSet& free, bool coulomb_load,
-                                     const std::vector<std::size_t>& samples) {
+                                     double compliance, const std::vector<std::size_t>& samples) {
   ObserverFit f;
   f.m = start;
   f.z = {0, start[kFL] / start[kJL], start[kTL] / start[kJL]};
   for (int level = 3; level >= 0; --level) {
+    f.z.compliance = compliance * f.m[kJL];
     Signals coarse = s;
     const double cutoff = s.filter.cutoff_hz / std::pow(2.0, level);
     if (level > 0) {
@@ -479,7 +481,7 @@ std::vector<double> observer_sigma(const Signals& s, ObserverFit& f, const FreeS
     Theta m = f.m;
     for (std::size_t j = 0; j < order.size(); ++j) m[order[j]] = p[j + 1];
     const double JL = std::max(m[kJL], 1e-12 * f.m[kJL]);
-    const Shape z{std::max(0.0, p[0]), std::max(0.0, m[kFL]) / JL, std::max(0.0, m[kTL]) / JL};
+    const Shape z{std::max(0.0, p[0]), std::max(0.0, m[kFL]) / JL, std::max(0.0, m[kTL]) / JL, f.z.compliance};
     Theta mt = m;
     mt[kJL] = JL, mt[kFL] = mt[kTL] = 0;
     const std::vector<double> all = residuals(s, tied_load(s, z), mt);
@@ -584,6 +586,7 @@ struct Fitted {
   FreeSet free{};
   std::vector<double> sigma;
   double given_b = 0, b = 0, sigma_b = NAN;
+  double compliance = 0;  // 1/kc of the file's mesh (0: rigid), held with the motor encoder alone
   std::vector<double> r_given, r_nominal, r_after;
   std::vector<std::size_t> all;
 };
@@ -640,11 +643,11 @@ void motor_encoder(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   const std::vector<std::size_t> samples = observer_samples(s);
   FreeSet everything = f.free;
   for (const auto& [effect, which] : effect_columns()) everything[which] = which != kTL && f.given[which] == 0;
-  ObserverFit first = fit_shape_coarse_to_fine(s, f.given, everything, true, samples);
+  ObserverFit first = fit_shape_coarse_to_fine(s, f.given, everything, true, f.compliance, samples);
   if (!std::isfinite(first.sse)) throw std::invalid_argument(s.name + ": the record does not fit a physical drive with the load's parameters free (JL > 0, FL >= 0)");
   Theta nominal = first.m;
   for (int i : {kTm, kTL, kT0}) nominal[i] = f.given[i];
-  const LoadSide l = observed_load(s, first.z.b, first.m);
+  const LoadSide l = observed_load(s, first.z.b, first.m, f.compliance);
   const LinearFit best_nominal = solve(s, l, nominal, f.free, samples);
   f.nominal = best_nominal.ok ? best_nominal.m : nominal;
   Search w{s, l, samples, {}, {}, options};
@@ -656,13 +659,13 @@ void motor_encoder(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   fit_shape(s, final_fit, f.free, coulomb_load, false, samples);
   f.sigma = observer_sigma(s, final_fit, f.free, coulomb_load, samples);
   f.m = final_fit.m, f.b = final_fit.z.b, f.sigma_b = final_fit.sigma_b;
-  f.r_given = residuals(s, observed_load(s, f.given_b, f.given), f.given);
+  f.r_given = residuals(s, observed_load(s, f.given_b, f.given, f.compliance), f.given);
   f.r_nominal = residuals(s, l, f.nominal);
-  f.r_after = residuals(s, observed_load(s, f.b, f.m), f.m);
+  f.r_after = residuals(s, observed_load(s, f.b, f.m, f.compliance), f.m);
   f.all = samples;
   two.torque_rms_rigid = std::sqrt(final_fit.sse_rigid / static_cast<double>(std::max<std::size_t>(1, samples.size())));
   two.contact_fraction = NAN;
-  const std::vector<double> model_gap = load_observer(s.qmf, s.vm, s.am, s.fs, f.b, 0, f.m[kJL], f.m[kFL], f.m[kTL]);
+  const std::vector<double> model_gap = load_observer(s.qmf, s.vm, s.am, s.fs, f.b, 0, f.m[kJL], f.m[kFL], f.m[kTL], f.compliance);
   two.reversals = lost_motion(s, nullptr, model_gap);
 }
 
@@ -716,6 +719,7 @@ DriveDiscrepancyResult find(const model::CaseSpec& spec, const measurements::Mea
   Fitted f;
   f.given = given_theta(given, file_effects);
   f.given_b = given.backlash;
+  f.compliance = file_effects.compliant() ? 1 / file_effects.mesh_stiffness : 0;
   f.free = nominal_free_of(spec, where);
   for (int i : {kTm, kTL, kT0}) f.free[i] = false;
   result.corrected_effects = file_effects;

@@ -34,10 +34,10 @@ void coast(double& x, double& v, double h, double JL, double FL, double TL) {
 }  // namespace
 
 std::vector<double> load_observer(std::span<const double> qm, std::span<const double> vm, std::span<const double> am,
-                                  double fs, double b, double x0, double JL, double FL, double TL) {
+                                  double fs, double b, double x0, double JL, double FL, double TL, double compliance) {
   const std::size_t n = qm.size();
   if (vm.size() != n || am.size() != n) throw std::invalid_argument("load_observer: qm, vm and am differ in length");
-  if (!(fs > 0) || !(b >= 0) || !(JL > 0) || !(FL >= 0) || !(TL >= 0) || !std::isfinite(x0))
+  if (!(fs > 0) || !(b >= 0) || !(JL > 0) || !(FL >= 0) || !(TL >= 0) || !std::isfinite(x0) || !(compliance >= 0))
     throw std::invalid_argument("load_observer: needs fs > 0, b >= 0, JL > 0, FL >= 0, TL >= 0, finite x0 (got fs " + std::to_string(fs) + ", b " + std::to_string(b) + ", JL " + std::to_string(JL) + ", FL " + std::to_string(FL) + ", TL " + std::to_string(TL) + ")");
   std::vector<double> gap(n, x0 - b / 2);
   if (n == 0) return gap;
@@ -56,7 +56,7 @@ std::vector<double> load_observer(std::span<const double> qm, std::span<const do
     if (contact) {
       const double s = vm[k] > 0 ? 1 : vm[k] < 0 ? -1 : 0;
       const double push = JL * am[k] + FL * vm[k] + TL * s;  // the torque the load needs to follow: R
-      xL = qm[k] + x0 + face * b / 2, vL = vm[k];
+      xL = qm[k] + x0 + face * b / 2 - compliance * push, vL = vm[k];  // the mesh deflected by R/kc
       if (-face * push < 0 && b > 0) contact = false;  // holding the face would need a pull
     } else {
       coast(xL, vL, h, JL, FL, TL);

@@ -73,8 +73,10 @@ struct TwoBodyFindings {
 /// back face at rest).  Contact on face σ holds while −σ·(JL·am + FL·vm + TL·sgn vm) ≥ 0 (the
 /// motor pushes; a pull would be needed otherwise); in flight the load coasts (exact closed form
 /// over each sample, sticking at v = 0 under Coulomb friction) until x reaches a face, where the
-/// inelastic impact puts it in contact again.
+/// inelastic impact puts it in contact again.  `compliance` = 1/kc ≥ 0 (0: a rigid mesh): in
+/// contact the mesh is deflected quasi-statically, x = x0 + σ·b/2 − R/kc with R the torque the
+/// load needs (its resonance is taken to lie above the band compared).
 std::vector<double> load_observer(std::span<const double> qm, std::span<const double> vm, std::span<const double> am,
-                                  double fs, double b, double x0, double JL, double FL, double TL);
+                                  double fs, double b, double x0, double JL, double FL, double TL, double compliance = 0);
 
 }  // namespace backlash::discrepancy
