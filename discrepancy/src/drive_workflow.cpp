@@ -1011,17 +1011,13 @@ detail::DriveBand detail::drive_band(const std::vector<double>& q, const std::ve
 
 std::size_t detail::drive_filter_edge(const measurements::ButterworthLowPass& filter) { return edge_samples(filter); }
 
-DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const measurements::MeasuredRecord& data,
-                                              const DriveOptions& options, const measurements::MeasuredRecord* validation) {
+namespace {
+
+// The rigid drive (backlash 0).
+DriveDiscrepancyResult find_rigid_drive(const model::CaseSpec& spec, const measurements::MeasuredRecord& data,
+                                        const DriveOptions& options, const measurements::MeasuredRecord* validation) {
   const auto started = std::chrono::steady_clock::now();
   const std::string where = spec.source.filename().string();
-  if (spec.experiment && spec.experiment->kind == model::ExperimentKind::Drive && spec.backlash != 0) {
-    if (validation)
-      throw std::invalid_argument(validation->source.string() + ": a validation record is not yet scored on a drive with a gap (backlash > 0)");
-    DriveDiscrepancyResult result = two_body::find(spec, data, options);
-    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    return result;
-  }
   check_drive_inputs(spec, where, data, validation);
   const double gain = model::to_double(spec.experiment->drive_gain);
   const double t_end = spec.experiment->t_end ? model::to_double(*spec.experiment->t_end) : INFINITY;
@@ -1094,6 +1090,21 @@ DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const
   estimation_traces(p, band, r_nominal, r_after, nominal, current, gain, options, result);
   if (validation) score_validation(*validation, band, fs, gain, nominal, current, options, result);
   result.least_squares = w.least_squares;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return result;
+}
+
+}  // namespace
+
+DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const measurements::MeasuredRecord& data,
+                                              const DriveOptions& options, const measurements::MeasuredRecord* validation) {
+  if (!spec.experiment || spec.experiment->kind != model::ExperimentKind::Drive || spec.backlash == 0)
+    return find_rigid_drive(spec, data, options, validation);
+  // A drive with a gap: two bodies (two_body_drive.hpp).
+  const auto started = std::chrono::steady_clock::now();
+  if (validation)
+    throw std::invalid_argument(validation->source.string() + ": a validation record is not yet scored on a drive with a gap (backlash > 0)");
+  DriveDiscrepancyResult result = two_body::find(spec, data, options);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
