@@ -138,8 +138,10 @@ struct DriveDiscrepancyResult {
 
 /// The whole workflow on a measured-drive record.  `validation`: a second record of the same
 /// drive, scored without refitting.  Throws std::invalid_argument for a model or record it
-/// cannot use (a backlash, a free parameter a rigid drive cannot show, no drive column,
-/// non-uniform sampling, too short a record), naming the problem.
+/// cannot use (a free parameter a rigid drive cannot show, no drive column, no theta_out on a
+/// rigid drive, no theta_motor on a drive with a gap, non-uniform sampling, too short a
+/// record), naming the problem.  A model with backlash > 0 runs the two-body workflow
+/// (two_body_drive.hpp; the result's `two_body` is set; no validation record yet).
 DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& model, const measurements::MeasuredRecord& data,
                                               const DriveOptions& options = {},
                                               const measurements::MeasuredRecord* validation = nullptr);
