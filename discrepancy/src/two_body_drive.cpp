@@ -503,12 +503,12 @@ namespace {
 // The record a drive with a gap needs: the logged drive and the motor's encoder (theta_load
 // optional), named by file, line 1 and column when missing.
 void check_inputs(const model::CaseSpec& spec, const measurements::MeasuredRecord& data) {
-  const std::string file = data.source.string();
+  const std::string file = data.source.string() + (data.source.extension() == ".mat" ? "" : ":1");  // a CSV's header line
   if (!data.drive)
-    throw std::invalid_argument(file + ":1: drive: missing column: a drive with a gap (backlash > 0 in " +
+    throw std::invalid_argument(file + ": drive: missing column: a drive with a gap (backlash > 0 in " +
                                 spec.source.filename().string() + ") needs the logged drive (t, theta_motor[, theta_load], drive)");
   if (!data.theta_motor)
-    throw std::invalid_argument(file + ":1: theta_motor: missing column: a drive with a gap (backlash > 0 in " +
+    throw std::invalid_argument(file + ": theta_motor: missing column: a drive with a gap (backlash > 0 in " +
                                 spec.source.filename().string() + ") needs the motor encoder (t, theta_motor[, theta_load], drive)");
 }
 
