@@ -27,6 +27,14 @@ void append_effects(std::string& out, const std::vector<discrepancy::Candidate>&
   }
 }
 
+/// A drive with a gap: the parameter corrections (the backlash first) and the lost motion.
+void append_two_body(std::string& out, const discrepancy::TwoBodyFindings& two) {
+  appendf(out, "  drive with a gap, %s; %d reversals of the motor\n", two.method.c_str(), two.reversals_count);
+  for (const discrepancy::ParameterCorrection& c : two.parameter_corrections)
+    appendf(out, "  %-14s  %.6g -> %.6g ± %.2g  (x%.4g)\n", c.key.c_str(), c.nominal, c.fitted, c.uncertainty, c.ratio);
+  if (two.rigid) appendf(out, "  a rigid drive: the backlash is not distinguishable from 0 (within 3 sigma)\n");
+}
+
 }  // namespace
 
 measurements::MeasuredRecord read_record(const std::filesystem::path& file) {
@@ -110,6 +118,8 @@ Discrepancy discrepancy(const Case& model, const measurements::MeasuredRecord& d
     throw BadInput("step", *problem);
   if (request.threads < 1 || request.threads > 256)
     throw BadInput("threads", "expected an integer from 1 to 256, got " + std::to_string(request.threads));
+  if (data.theta_out.size() != data.size())  // a logged drive's record may leave it out (measured_record.hpp)
+    throw measurements::MeasuredDataError(data.source, 1, "theta_out", "missing required column (the step workflow compares the measured shaft)");
   discrepancy::DiscrepancyOptions options;
   options.threads = request.threads;
   options.progress = request.progress;
@@ -136,6 +146,10 @@ std::string Discrepancy::text(const std::string& data, const std::string& valida
               r.rounds.front().front().rms);
     appendf(out, "  torque RMS: %.4g before (best nominal), %.4g after (noise level %.3g)\n", r.rms_before, r.rms_after,
             r.noise);
+    if (r.two_body) {
+      append_two_body(out, *r.two_body);
+      return out;
+    }
     appendf(out, "  position RMS over %d windows of %.3g s: %.4g before, %.4g after\n", r.estimation.windows, window_,
             r.estimation.position_rms_nominal, r.estimation.position_rms_corrected);
     if (r.validation)

@@ -3,7 +3,9 @@
 // checked over windows restarted from the measured state.
 #include "backlash/discrepancy/measured_drive.hpp"
 
+#include "drive_internal.hpp"
 #include "quiet_ceres.hpp"
+#include "two_body_signals.hpp"
 
 #include "backlash/measurements/inverse_dynamics_signals.hpp"
 #include "backlash/discrepancy/measured_drive_simulation.hpp"
@@ -87,13 +89,7 @@ struct Prepared {
   bool compared(std::size_t k) const { return in[k] != 0; }
 };
 
-struct Band {
-  measurements::ButterworthLowPass filter;
-  double cutoff = 0, floor = NAN;
-  bool from_spectrum = true;
-  double rest_speed = 0;
-  std::size_t edge = 0;  // samples left out at each end of a record
-};
+using Band = detail::DriveBand;
 
 // The filter's effective length: the smallest m such that the zero-phase impulse response
 // outside ±m samples holds at most 10⁻⁴ of its absolute sum — the end transients of the
@@ -710,11 +706,13 @@ void check_drive_inputs(const model::CaseSpec& spec, const std::string& where, c
                         const measurements::MeasuredRecord* validation) {
   if (!spec.experiment || spec.experiment->kind != model::ExperimentKind::Drive)
     throw std::invalid_argument(where + ": the model's [experiment] is not a measured drive (kind = \"drive\")");
-  if (spec.backlash != 0)
-    throw std::invalid_argument(where + ": backlash: a measured-drive model is a rigid drive (backlash 0); a drive with a gap and a logged drive is not supported");
   if (!data.drive) throw std::invalid_argument(data.source.string() + ": no drive column: a measured-drive model needs the logged drive");
   if (validation && !validation->drive)
     throw std::invalid_argument(validation->source.string() + ": no drive column: a measured-drive model needs the logged drive");
+  for (const measurements::MeasuredRecord* record : {&data, validation})
+    if (record && record->theta_out.size() != record->size())
+      throw std::invalid_argument(record->source.string() +
+                                  ":1: theta_out: missing column: a rigid drive's record gives the measured shaft (t, theta_out, drive)");
 }
 
 // The free nominal parameters: on a rigid drive only J and F show (the names as given, with
@@ -1006,8 +1004,18 @@ std::size_t samples_before(const measurements::MeasuredRecord& data, double t_en
 
 }  // namespace
 
-DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const measurements::MeasuredRecord& data,
-                                              const DriveOptions& options, const measurements::MeasuredRecord* validation) {
+detail::DriveBand detail::drive_band(const std::vector<double>& q, const std::vector<double>& u, double fs,
+                                     const DriveOptions& options, DriveDiscrepancyResult& result) {
+  return band_of(q, u, fs, options, result);
+}
+
+std::size_t detail::drive_filter_edge(const measurements::ButterworthLowPass& filter) { return edge_samples(filter); }
+
+namespace {
+
+// The rigid drive (backlash 0).
+DriveDiscrepancyResult find_rigid_drive(const model::CaseSpec& spec, const measurements::MeasuredRecord& data,
+                                        const DriveOptions& options, const measurements::MeasuredRecord* validation) {
   const auto started = std::chrono::steady_clock::now();
   const std::string where = spec.source.filename().string();
   check_drive_inputs(spec, where, data, validation);
@@ -1082,6 +1090,21 @@ DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const
   estimation_traces(p, band, r_nominal, r_after, nominal, current, gain, options, result);
   if (validation) score_validation(*validation, band, fs, gain, nominal, current, options, result);
   result.least_squares = w.least_squares;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return result;
+}
+
+}  // namespace
+
+DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const measurements::MeasuredRecord& data,
+                                              const DriveOptions& options, const measurements::MeasuredRecord* validation) {
+  if (!spec.experiment || spec.experiment->kind != model::ExperimentKind::Drive || spec.backlash == 0)
+    return find_rigid_drive(spec, data, options, validation);
+  // A drive with a gap: two bodies (two_body_drive.hpp).
+  const auto started = std::chrono::steady_clock::now();
+  if (validation)
+    throw std::invalid_argument(validation->source.string() + ": a validation record is not yet scored on a drive with a gap (backlash > 0)");
+  DriveDiscrepancyResult result = two_body::find(spec, data, options);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }

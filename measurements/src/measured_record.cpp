@@ -52,8 +52,9 @@ std::vector<double>& column_values(MeasuredRecord& record, std::size_t index) {
 
 /// The record's columns present, in writing order, with their names.
 std::vector<std::pair<std::string_view, const std::vector<double>*>> present_columns(const MeasuredRecord& record) {
-  std::vector<std::pair<std::string_view, const std::vector<double>*>> columns{{column_names[0], &record.t},
-                                                                                {column_names[1], &record.theta_out}};
+  std::vector<std::pair<std::string_view, const std::vector<double>*>> columns{{column_names[0], &record.t}};
+  if (!record.theta_out.empty() || !record.theta_motor || !record.drive)  // left out only in a logged drive's record
+    columns.emplace_back(column_names[1], &record.theta_out);
   if (record.theta_motor) columns.emplace_back(column_names[2], &*record.theta_motor);
   if (record.theta_load) columns.emplace_back(column_names[3], &*record.theta_load);
   if (record.drive) columns.emplace_back(column_names[4], &*record.drive);
@@ -248,8 +249,12 @@ class CsvReader {
       position_of[*index] = position + 1;
       header_.push_back(*index);
     }
+    // theta_out may be left out of a logged drive's record (theta_motor and drive present): the
+    // measured-drive workflow on a drive with a gap reads the encoders themselves.
+    const bool logged_drive = position_of[2] != 0 && position_of[4] != 0;
     for (const std::size_t required : {t_index, theta_out_index})
-      if (position_of[required] == 0) fail(1, std::string(column_names[required]), "missing required column");
+      if (position_of[required] == 0 && !(required == theta_out_index && logged_drive))
+        fail(1, std::string(column_names[required]), "missing required column");
   }
 
   std::string_view text_;

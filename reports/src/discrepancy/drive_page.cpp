@@ -5,6 +5,7 @@
 
 #include "page_json.hpp"
 #include "plots.hpp"
+#include "two_body_page.hpp"
 
 #include "backlash/model/case_writer.hpp"
 
@@ -143,6 +144,10 @@ std::string drive_to_json(const model::CaseSpec& model, const DriveDiscrepancyRe
       {"estimation", scores_json(r.estimation)},
       {"validation", r.validation ? scores_json(*r.validation) : nlohmann::json(nullptr)},
       {"least_squares", r.least_squares}};
+  if (r.two_body) {  // a drive with a gap (two_body_drive.hpp)
+    out["parameter_corrections"] = detail::two_body_corrections_json(*r.two_body);
+    out["two_body"] = detail::two_body_json(*r.two_body);
+  }
   return out.dump(2) + "\n";
 }
 
@@ -164,7 +169,8 @@ std::string drive_corrected_case_file(const model::CaseSpec& spec, const DriveDi
   const numeric::Parameters& p = r.parameters;
   c.name = spec.name + " (corrected)";
   c.measured_at = spec.measured_at;
-  c.K = model::exact_text(spec.K), c.backlash = "0", c.reference = model::exact_text(spec.reference);
+  c.K = model::exact_text(spec.K), c.reference = model::exact_text(spec.reference);
+  c.backlash = r.two_body ? model::exact_or_decimal(spec.backlash, p.backlash) : "0";
   c.Jm = model::exact_or_decimal(spec.Jm, p.Jm), c.Fm = model::exact_or_decimal(spec.Fm, p.Fm);
   c.JL = model::exact_or_decimal(spec.JL, p.JL), c.FL = model::exact_or_decimal(spec.FL, p.FL);
   model::ExperimentText x{model::ExperimentKind::Drive, "", model::exact_text(spec.experiment->drive_gain), std::nullopt,
@@ -177,6 +183,27 @@ std::string drive_corrected_case_file(const model::CaseSpec& spec, const DriveDi
 }
 
 namespace {
+
+// A drive with a gap: torque over the first three seconds, the lost motion, the hysteresis loop,
+// the first round's candidates.
+std::optional<std::string> two_body_drive_figures(const DriveDiscrepancyResult& r, std::vector<reports::Plot>& figures,
+                                                  std::vector<std::pair<std::string, std::string>>& files) {
+  const bool found = !r.effects.empty();
+  const std::pair<std::size_t, std::size_t> range{0, static_cast<std::size_t>(std::lower_bound(r.t.begin(), r.t.end(), r.t.front() + 3) - r.t.begin())};
+  const std::vector<double> t = slice(r.t, range), measured = slice(r.torque_measured, range),
+                            nominal = slice(r.torque_nominal, range), corrected = slice(r.torque_corrected, range);
+  std::vector<Curve> torque{{"measured (filtered)", "#222", &t, &measured}, {"nominal needs", "#c33", &t, &nominal, true}};
+  if (found) torque.push_back({"corrected needs", "#2a7", &t, &corrected});
+  figures.push_back(line_plot("torque_over_time", "Drive torque: measured, and what each model needs along the measured motion",
+                              "t [s]", "drive torque [N·m]", torque));
+  detail::two_body_figures(*r.two_body, figures);
+  std::vector<std::pair<std::string, double>> bars;
+  if (!r.rounds.empty())
+    for (const Candidate& c : r.rounds.front()) bars.push_back({c.effect, c.rms});
+  figures.push_back(bar_chart("candidates", "First round: torque RMS with each candidate effect fitted", bars, r.rms_before,
+                              "best nominal " + number(r.rms_before)));
+  return add_figures(figures, files);
+}
 
 // The figures: the torque residual against velocity, torque and position over the nominal
 // model's worst windows (and the validation record's), the first round's candidates.  Drawn
@@ -201,7 +228,9 @@ std::optional<std::string> drive_figures(const DriveDiscrepancyResult& r, std::v
   figures.push_back(line_plot("torque_residual_vs_velocity",
                               "Torque residual (measured drive − model's inverse dynamics) against velocity", "velocity [m/s]",
                               "force residual [N]", scatter, {}, {{0.0, "zero"}}));
-  // Torque over time and position over windows: the stretch around the nominal model's worst window.
+  // Torque over time and position over windows: the stretch around the nominal model's worst window
+  // (a drive with a gap: its own figures instead of the windows).
+  if (r.two_body) return two_body_drive_figures(r, figures, files);
   const auto range = worst_windows(r.t, r.position, r.position_nominal, r.window_starts, 3);
   const std::vector<double> t = slice(r.t, range), measured = slice(r.torque_measured, range),
                             nominal = slice(r.torque_nominal, range), corrected = slice(r.torque_corrected, range);
@@ -351,8 +380,14 @@ std::vector<std::pair<std::string, std::string>> drive_report_files(const model:
   std::ostringstream md;
   drive_page_head(md, model, data_name, r);
   drive_page_fits(md, r);
-  drive_page_gap(md, data_name, validation_name, !not_drawn, r);
-  drive_page_regions(md, r);
+  if (r.two_body) {
+    detail::two_body_page(md, *r.two_body, !not_drawn);
+    md << "\nTorque RMS: " << number(r.rms_given) << " (the model as given), " << number(r.rms_before) << " (best nominal), "
+       << number(r.rms_after) << " (corrected).\n\n" << (not_drawn ? "" : "![torque over time](torque_over_time.svg)\n\n");
+  } else {
+    drive_page_gap(md, data_name, validation_name, !not_drawn, r);
+    drive_page_regions(md, r);
+  }
   drive_page_candidates(md, r, not_drawn);
   files.push_back({"discrepancy.md", md.str()});
   return files;

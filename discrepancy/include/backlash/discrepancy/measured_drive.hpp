@@ -1,7 +1,8 @@
 // backlash/discrepancy/measured_drive.hpp — the discrepancy workflow on a record of a
 // real drive whose drive torque is logged (docs/discrepancy.md §"Measured drive").
 //
-// The model (a case file with `[experiment] kind = "drive"`) is a rigid drive, backlash 0:
+// The model (a case file with `[experiment] kind = "drive"` and backlash 0) is a rigid drive
+// (a backlash > 0 makes it two bodies with their gap: two_body_drive.hpp):
 //     J·q'' + F·q' + Tc·sgn(q') = u(t − τ) + T0,   u = sat_L(gain · drive)
 // with J = Jm + JL, F = Fm + FL, and the effects of the vocabulary that make sense without a
 // gap: Coulomb friction Tc (coulomb_motor; on a rigid drive the motor's and the load's are
@@ -54,6 +55,7 @@
 #include "backlash/model/case_spec.hpp"
 #include "backlash/numeric/effects.hpp"
 #include "backlash/discrepancy/measured_drive_simulation.hpp"
+#include "backlash/discrepancy/two_body_drive.hpp"
 
 #include <cmath>
 #include <optional>
@@ -127,14 +129,19 @@ struct DriveDiscrepancyResult {
   std::vector<double> position, position_nominal, position_corrected;  ///< window predictions
   std::vector<double> window_starts;
   std::vector<double> validation_t, validation_position, validation_nominal, validation_corrected, validation_window_starts;
+  /// A drive with a gap (backlash > 0 in the model file): the two-body findings
+  /// (two_body_drive.hpp); absent for a rigid drive.
+  std::optional<TwoBodyFindings> two_body;
   int least_squares = 0;  ///< least-squares solves the fits used
   double seconds = 0;
 };
 
 /// The whole workflow on a measured-drive record.  `validation`: a second record of the same
 /// drive, scored without refitting.  Throws std::invalid_argument for a model or record it
-/// cannot use (a backlash, a free parameter a rigid drive cannot show, no drive column,
-/// non-uniform sampling, too short a record), naming the problem.
+/// cannot use (a free parameter a rigid drive cannot show, no drive column, no theta_out on a
+/// rigid drive, no theta_motor on a drive with a gap, non-uniform sampling, too short a
+/// record), naming the problem.  A model with backlash > 0 runs the two-body workflow
+/// (two_body_drive.hpp; the result's `two_body` is set; no validation record yet).
 DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& model, const measurements::MeasuredRecord& data,
                                               const DriveOptions& options = {},
                                               const measurements::MeasuredRecord* validation = nullptr);

@@ -2,7 +2,8 @@
 //
 // Contract (docs/design.md, "Measured data (CSV)"): a header row naming
 // the columns; `t` and `theta_out` (the measured shaft) required, `theta_motor`,
-// `theta_load` and `drive` optional, in any order; `t` strictly increasing; every
+// `theta_load` and `drive` optional, in any order (`theta_out` may be left out of a logged
+// drive's record, one with `theta_motor` and `drive`: then theta_out is empty); `t` strictly increasing; every
 // cell a finite number.  Anything else is a MeasuredDataError whose what() is
 // one line, "FILE:LINE: COLUMN: problem" (LINE and COLUMN left out where they do
 // not apply), in the spirit of the case-file loader (model/case_spec.hpp).
@@ -31,7 +32,7 @@ namespace backlash::measurements {
 /// One measured record: a time series with the columns of the CSV contract.
 struct MeasuredRecord {
   std::vector<double> t;                         ///< time [s], strictly increasing
-  std::vector<double> theta_out;                 ///< the measured shaft
+  std::vector<double> theta_out;                 ///< the measured shaft (empty: left out of a logged drive's record)
   std::optional<std::vector<double>> theta_motor;
   std::optional<std::vector<double>> theta_load;
   std::optional<std::vector<double>> drive;      ///< drive torque/force applied to the mechanism

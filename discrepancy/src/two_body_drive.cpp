@@ -1,0 +1,748 @@
+// The measured-drive workflow on a drive with a gap (two_body_drive.hpp): the record prepared,
+// the load's parameters and the frictions from the summed equation, the effects named by the
+// decisive rule, the backlash from the gap (both encoders) or from the load observer (the motor
+// encoder alone), the lost motion at each reversal.
+#include "two_body_signals.hpp"
+
+#include "drive_internal.hpp"
+
+#include "backlash/numeric/effects.hpp"
+#include "backlash/numeric/parameters.hpp"
+
+#include <Eigen/Dense>
+#include <boost/math/tools/minima.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace backlash::discrepancy::two_body {
+
+namespace {
+
+constexpr double kNoiseFactor = 1.15;  // as the rigid workflow's: a residual within it is noise
+
+}  // namespace
+
+void filter_signals(Signals& s, const measurements::ButterworthLowPass& filter, std::size_t edge) {
+  const std::size_t n = s.size();
+  s.filter = filter;
+  s.reach = edge + 2;
+  s.begin = std::min(edge, n / 4);
+  s.end = n - s.begin;
+  s.qmf = measurements::zero_phase_filter(s.qm, s.filter);
+  const measurements::Derivatives d = measurements::derivatives(s.qmf, s.fs);
+  s.vm = d.velocity;
+  s.am = d.acceleration;
+  s.sm = signs_of(s.qm, s.vm, s.rest_speed, true);
+  s.sm_f = measurements::zero_phase_filter(std::vector<double>(s.sm.begin(), s.sm.end()), s.filter);
+  std::vector<double> held(n);
+  for (std::size_t k = 0; k < n; ++k) held[k] = 0.5 * (s.u[k] + s.u[k == 0 ? 0 : k - 1]);  // the zero-order hold's average
+  s.Uf = measurements::zero_phase_filter(held, s.filter);
+}
+
+namespace {
+
+// The record: uniform sampling, the band (the cut-off from the motor position's spectrum unless
+// given), the filtered motor signals and the held drive.
+Signals prepare(const model::CaseSpec& spec, const measurements::MeasuredRecord& data, const DriveOptions& options,
+                DriveDiscrepancyResult& result) {
+  Signals s;
+  s.name = data.source.filename().string();
+  const double gain = model::to_double(spec.experiment->drive_gain);
+  const double t_end = spec.experiment->t_end ? model::to_double(*spec.experiment->t_end) : INFINITY;
+  std::size_t n = data.size();
+  while (n > 0 && data.t[n - 1] > t_end) --n;
+  if (n < 200) throw std::invalid_argument(data.source.string() + ": fewer than 200 samples before t_end: too short for inverse dynamics");
+  auto head = [n](const std::vector<double>& v) { return std::vector<double>(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n)); };
+  s.t = head(data.t);
+  s.qm = head(*data.theta_motor);
+  if (data.theta_load) s.qL = head(*data.theta_load);
+  s.u = head(*data.drive);
+  for (double& x : s.u) x *= gain;
+  try {
+    s.fs = measurements::uniform_sample_rate(s.t);
+  } catch (const std::invalid_argument& error) {
+    throw std::invalid_argument(data.source.string() + ": t: " + error.what());
+  }
+  const detail::DriveBand band = detail::drive_band(s.qm, s.u, s.fs, options, result);
+  s.rest_speed = band.rest_speed;
+  if (s.qL.empty() && !std::isfinite(options.cutoff)) {
+    // The motor encoder alone: the load observer's contact is rigid, which holds below the mesh's
+    // resonance; the band is cut at a quarter of the spectrum's cut-off (docs/discrepancy.md).
+    result.cutoff = band.cutoff / 4;
+    const measurements::ButterworthLowPass filter = measurements::design_butterworth_low_pass(result.cutoff, s.fs);
+    filter_signals(s, filter, detail::drive_filter_edge(filter));
+    return s;
+  }
+  filter_signals(s, band.filter, band.edge);
+  return s;
+}
+
+// The model as the file gives it.
+Theta given_theta(const numeric::Parameters& p, const numeric::Effects& e) {
+  return {p.Jm, p.Fm, p.JL, p.FL, e.coulomb_motor, e.coulomb_load, e.torque_offset};
+}
+
+// The nominal parameters fitted: the load's inertia and viscous friction always, the motor's when
+// the file marks them free ([fit] free); anything else is refused, naming the key.
+FreeSet nominal_free_of(const model::CaseSpec& spec, const std::string& where) {
+  FreeSet free{};
+  free[kJL] = free[kFL] = true;
+  for (const std::string& name : spec.fit_free) {
+    if (name == "motor.J") free[kJm] = true;
+    else if (name == "motor.F") free[kFm] = true;
+    else if (name != "load.J" && name != "load.F" && name != "backlash")
+      throw std::invalid_argument(where + ": fit.free: " + name +
+                                  (name == "K" ? " is not part of a measured-drive model (the loop is open)"
+                                               : " cannot be fitted on a measured drive"));
+  }
+  return free;
+}
+
+// The samples of the fitted blocks (seven of ten: the third, sixth and ninth held out) and the
+// held-out ones.
+void split_blocks(const Signals& s, const std::vector<std::size_t>& all, std::vector<std::size_t>& fit,
+                  std::vector<std::size_t>& holdout) {
+  const std::size_t m = std::max<std::size_t>(1, s.end - s.begin);
+  for (std::size_t k : all) {
+    const std::size_t block = 10 * (k - s.begin) / m;
+    (block % 3 == 2 ? holdout : fit).push_back(k);
+  }
+}
+
+double sse_on(const std::vector<double>& r, const std::vector<std::size_t>& samples) {
+  double sum = 0;
+  for (std::size_t k : samples) sum += r[k] * r[k];
+  return sum;
+}
+
+double rms_on(const std::vector<double>& r, const std::vector<std::size_t>& samples) {
+  return std::sqrt(sse_on(r, samples) / static_cast<double>(std::max<std::size_t>(1, samples.size())));
+}
+
+double tau_int_on(const std::vector<double>& r, const std::vector<std::size_t>& samples) {
+  std::vector<double> inner;
+  for (std::size_t k : samples) inner.push_back(r[k]);
+  return std::max(1.0, measurements::integrated_autocorrelation_time(inner).tau);
+}
+
+// The effects the summed equation can name, in the order tried.
+const std::vector<std::pair<std::string, int>>& effect_columns() {
+  static const std::vector<std::pair<std::string, int>> columns{{"coulomb_motor", kTm}, {"coulomb_load", kTL}, {"torque_offset", kT0}};
+  return columns;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------ the decisive rule
+
+namespace {
+
+struct Search {
+  const Signals& s;
+  const LoadSide& l;
+  std::vector<std::size_t> all, fit, holdout;
+  const DriveOptions& options;
+};
+
+// One round: every remaining effect added to `current`, fitted on the fitted blocks and judged
+// against it (ΔBIC with n_eff = n/τ_int, the held-out RMS, no friction pinned at 0).  Returns
+// the index in effect_columns() of the winner, or −1.
+int search_round(const Search& w, const Theta& current, const FreeSet& free, std::vector<Candidate>& round) {
+  const LinearFit base = solve(w.s, w.l, current, free, w.fit);
+  if (!base.ok) return -1;
+  const std::vector<double> r_base = residuals(w.s, w.l, base.m);
+  const double base_holdout = rms_on(r_base, w.holdout);
+  const double n_eff = static_cast<double>(w.fit.size()) / tau_int_on(r_base, w.fit);
+  int winner = -1;
+  double best = INFINITY;
+  for (std::size_t e = 0; e < effect_columns().size(); ++e) {
+    const auto& [effect, which] = effect_columns()[e];
+    if (free[which] || current[which] != 0) continue;  // named already, or in the file
+    FreeSet trial = free;
+    trial[which] = true;
+    const LinearFit l = solve(w.s, w.l, base.m, trial, w.fit);
+    Candidate c;
+    c.effect = effect;
+    if (!l.ok) {
+      c.failure = "the least-squares fit gave no physical drive";
+      c.rms = c.rms_holdout = c.delta_bic = INFINITY;
+      round.push_back(c);
+      continue;
+    }
+    const std::vector<double> r = residuals(w.s, w.l, l.m);
+    c.parameters = {{"torque", l.m[which], NAN}};
+    c.rms = rms_on(r, w.all);
+    c.rms_fit = std::sqrt(l.sse / static_cast<double>(w.fit.size()));
+    c.rms_holdout = rms_on(r, w.holdout);
+    c.delta_bic = n_eff * std::log(std::max(l.sse, 1e-300) / std::max(base.sse, 1e-300)) + std::log(n_eff);
+    c.at_range_edge = l.clamped && l.m[which] == 0;
+    c.decisive = c.delta_bic < -w.options.decisive_bic && c.rms_holdout <= w.options.decisive_holdout * base_holdout &&
+                 !c.at_range_edge;
+    if (c.decisive && c.delta_bic < best) best = c.delta_bic, winner = static_cast<int>(e);
+    round.push_back(c);
+  }
+  std::stable_sort(round.begin(), round.end(), [](const Candidate& a, const Candidate& b) { return a.delta_bic < b.delta_bic; });
+  return winner;
+}
+
+// The rounds: the winner named, the model refitted on the whole record, again until none is
+// decisive.  Returns the model with its free set.
+Theta name_effects(const Search& w, Theta current, FreeSet& free, DriveDiscrepancyResult& result) {
+  while (static_cast<int>(result.effects.size()) < w.options.max_effects) {
+    std::vector<Candidate> round;
+    const int winner = search_round(w, current, free, round);
+    if (round.empty()) break;
+    result.rounds.push_back(round);
+    if (winner < 0) break;
+    const auto& [effect, which] = effect_columns()[static_cast<std::size_t>(winner)];
+    free[which] = true;
+    const LinearFit whole = solve(w.s, w.l, current, free, w.all);
+    if (whole.ok) current = whole.m;
+    const auto named = std::find_if(round.begin(), round.end(), [&](const Candidate& c) { return c.effect == effect; });
+    result.effects.push_back(*named);
+  }
+  return current;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------ the gap (both encoders)
+
+namespace {
+
+// The gap's fit on the faces: x = x0 + σ·b/2 − c·R over the samples in contact (c = 1/kc, 0 for
+// a rigid mesh), R the load's inverse dynamics.
+struct GapFit {
+  double x0 = 0, b = 0, c = 0;
+  double sigma_b = NAN, sigma_c = NAN;
+  std::vector<std::size_t> contact;
+  std::vector<signed char> face;  // at every sample: ±1 in contact, 0 in flight
+  double sse = INFINITY;
+  double contact_fraction = 0;
+};
+
+bool solve_gap(const Signals& s, const std::vector<double>& xf, const std::vector<double>& R, bool compliant, GapFit& g) {
+  std::vector<std::size_t> rows;
+  for (std::size_t k = s.begin + s.reach; k + s.reach < s.end; ++k) {
+    bool steady = g.face[k] != 0;
+    for (std::size_t j = k - s.reach; steady && j <= k + s.reach; ++j) steady = g.face[j] == g.face[k];
+    if (steady) rows.push_back(k);
+  }
+  const int cols = compliant ? 3 : 2;
+  if (rows.size() < 10) return false;
+  Eigen::MatrixXd A(rows.size(), cols);
+  Eigen::VectorXd y(rows.size());
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const std::size_t k = rows[i];
+    A(i, 0) = 1, A(i, 1) = 0.5 * g.face[k];
+    if (compliant) A(i, 2) = -R[k];
+    y(i) = xf[k];
+  }
+  const Eigen::VectorXd x = A.colPivHouseholderQr().solve(y);
+  if (!x.allFinite()) return false;
+  g.x0 = x(0), g.b = x(1), g.c = compliant ? x(2) : 0;
+  g.contact = rows;
+  g.sse = (A * x - y).squaredNorm();
+  return true;
+}
+
+// Contact where it is certain: the load's inverse dynamics R is the mesh torque, 0 in flight, and
+// on face σ it is −σ·P with P > 0; so the samples whose |R| exceeds a tenth of its 95th percentile
+// are in contact on face −sgn R (those within the filter's length of a change are left out by
+// solve_gap).  b, x0 (and 1/kc) by least squares over them.
+GapFit fit_gap(const Signals& s, const std::vector<double>& xf, const std::vector<double>& R, bool compliant) {
+  std::vector<double> size;
+  for (std::size_t k = s.begin; k < s.end; ++k) size.push_back(std::fabs(R[k]));
+  std::nth_element(size.begin(), size.begin() + static_cast<std::ptrdiff_t>(95 * size.size() / 100), size.end());
+  const double threshold = 0.1 * size[95 * size.size() / 100];
+  GapFit g;
+  g.face.assign(s.size(), 0);
+  for (std::size_t k = s.begin; k < s.end; ++k)
+    if (std::fabs(R[k]) > threshold) g.face[k] = R[k] > 0 ? -1 : 1;
+  if (!solve_gap(s, xf, R, compliant, g)) g.sse = INFINITY;
+  g.contact_fraction = static_cast<double>(g.contact.size()) / static_cast<double>(std::max<std::size_t>(1, s.end - s.begin));
+  return g;
+}
+
+// The uncertainties of the gap's fit (Ceres's covariance of the same linear model).
+void gap_sigma(const std::vector<double>& xf, const std::vector<double>& R, GapFit& g) {
+  std::vector<double> x{g.x0, g.b, g.c};
+  const std::size_t k = g.c != 0 ? 3 : 2;
+  x.resize(k);
+  const std::function<void(const double*, double*)> f = [&](const double* p, double* r) {
+    for (std::size_t i = 0; i < g.contact.size(); ++i) {
+      const std::size_t j = g.contact[i];
+      r[i] = xf[j] - (p[0] + 0.5 * g.face[j] * p[1] - (k == 3 ? p[2] * R[j] : 0.0));
+    }
+  };
+  const std::vector<double> sigma = ceres_sigma(f, g.contact.size(), x, std::vector<double>(k, -INFINITY), false);
+  g.sigma_b = sigma[1];
+  if (k == 3) g.sigma_c = sigma[2];
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------ the load observer (motor encoder alone)
+
+namespace {
+
+// The load side the observer reconstructs for gap b and the load's parameters in m.
+LoadSide observed_load(const Signals& s, double b, const Theta& m, double compliance) {
+  const std::vector<double> x = load_observer(s.qmf, s.vm, s.am, s.fs, b, 0, m[kJL], m[kFL], m[kTL], compliance);
+  std::vector<double> qL(s.size());
+  for (std::size_t k = 0; k < s.size(); ++k) qL[k] = s.qm[k] + x[k];
+  return load_side(s, std::move(qL), false);
+}
+
+// The samples compared with the motor encoder alone: the reversals stay in (the gap shows
+// there); only the motor's rests longer than the filter's length are left out, with that length
+// around them.
+std::vector<std::size_t> observer_samples(const Signals& s) {
+  const std::size_t n = s.size();
+  std::vector<char> in(n, 0);
+  for (std::size_t i = s.begin; i < s.end; ++i) in[i] = 1;
+  for (std::size_t i = 0; i < n;) {
+    std::size_t j = i;
+    while (j < n && std::fabs(s.vm[j]) <= s.rest_speed) ++j;
+    if (j - i >= s.reach)
+      for (std::size_t k = i >= s.reach ? i - s.reach : 0; k < std::min(n, j + s.reach); ++k) in[k] = 0;
+    i = j + 1;
+  }
+  std::vector<std::size_t> out;
+  for (std::size_t i = 0; i < n; ++i)
+    if (in[i]) out.push_back(i);
+  return out;
+}
+
+// The observer depends on the load only through its shape: the gap b and the decelerations per
+// unit velocity α = FL/JL and per unit inertia β = TL/JL.  For a shape, the residual is linear in
+// JL (the load's column aL + α·v̂L + β·s̄L) and in the motor's free parameters: variable projection.
+struct Shape {
+  double b = 0, alpha = 0, beta = 0;
+  double compliance = 0;  // 1/kc per unit load inertia (JL/kc: the observer runs with JL = 1); the file's, held
+};
+
+LoadSide tied_load(const Signals& s, const Shape& z) {
+  const std::vector<double> x = load_observer(s.qmf, s.vm, s.am, s.fs, z.b, 0, 1, z.alpha, z.beta, z.compliance);
+  std::vector<double> qL(s.size());
+  for (std::size_t k = 0; k < s.size(); ++k) qL[k] = s.qm[k] + x[k];
+  LoadSide l = load_side(s, std::move(qL), false);
+  for (std::size_t k = 0; k < s.size(); ++k) l.aL[k] += z.alpha * l.vL[k] + z.beta * l.sL_f[k], l.vL[k] = 0, l.sL_f[k] = 0;
+  return l;
+}
+
+LinearFit shape_fit(const Signals& s, const Shape& z, const Theta& start, FreeSet free, const std::vector<std::size_t>& samples) {
+  Theta m = start;
+  m[kFL] = m[kTL] = 0;
+  free[kJL] = true, free[kFL] = free[kTL] = false;
+  LinearFit f = solve(s, tied_load(s, z), m, free, samples);
+  if (f.ok) f.m[kFL] = z.alpha * f.m[kJL], f.m[kTL] = z.beta * f.m[kJL];
+  return f;
+}
+
+struct ObserverFit {
+  Shape z;
+  double sigma_b = NAN;
+  Theta m{};
+  double sse = INFINITY, sse_rigid = INFINITY;
+};
+
+// One coordinate of the shape by a scan of `grid` and Brent's minimisation in the best bracket.
+void coordinate(const Signals& s, ObserverFit& f, double Shape::*which, const std::vector<double>& grid, const FreeSet& free,
+                const std::vector<std::size_t>& samples) {
+  auto cost = [&](double value) {
+    Shape z = f.z;
+    z.*which = value;
+    return shape_fit(s, z, f.m, free, samples);
+  };
+  std::size_t arg = grid.size();
+  for (std::size_t j = 0; j < grid.size(); ++j) {
+    const LinearFit l = cost(grid[j]);
+    if (l.ok && l.sse < f.sse) f.sse = l.sse, f.m = l.m, f.z.*which = grid[j], arg = j;
+  }
+  if (arg == grid.size()) {  // the current point stays the best: refine around it
+    arg = static_cast<std::size_t>(std::lower_bound(grid.begin(), grid.end(), f.z.*which) - grid.begin());
+    arg = std::min(arg, grid.size() - 1);
+  }
+  const double lo = grid[arg == 0 ? 0 : arg - 1], hi = grid[std::min(arg + 1, grid.size() - 1)];
+  if (!(hi > lo)) return;
+  const auto [x, c] = boost::math::tools::brent_find_minima([&](double v) { const LinearFit l = cost(v); return l.ok ? l.sse : INFINITY; }, lo, hi, 30);
+  const LinearFit l = cost(x);
+  if (l.ok && l.sse < f.sse) f.sse = l.sse, f.m = l.m, f.z.*which = x;
+  (void)c;
+}
+
+// The grids of the shape's coordinates.  Wide (the first, coarsest band): b over 0 and 40
+// logarithmic points from the encoder's step to half the motor's travel, α and β over
+// [0, 4·A/V] and [0, 4·A] (A, V the 90th percentiles of |âm| and |v̂m|).  Narrow (the finer
+// bands): 0 and 13 points from 1/1.5 to 1.5 times the current b, from 1/5 to 5 times α and β.
+struct Grids {
+  std::vector<double> b, alpha, beta;
+};
+
+std::vector<double> around(double x, double factor) {
+  std::vector<double> g{0};
+  if (x > 0)
+    for (int j = -6; j <= 6; ++j) g.push_back(x * std::pow(factor, j / 6.0));
+  return g;
+}
+
+Grids grids_of(const Signals& s, const Shape& z, bool wide) {
+  if (!wide) return {around(z.b, 1.5), around(z.alpha, 5), around(z.beta, 5)};
+  double step = INFINITY, lo = INFINITY, hi = -INFINITY;
+  std::vector<double> A, V;
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    lo = std::min(lo, s.qm[k]), hi = std::max(hi, s.qm[k]);
+    if (k > 0 && s.qm[k] != s.qm[k - 1]) step = std::min(step, std::fabs(s.qm[k] - s.qm[k - 1]));
+    A.push_back(std::fabs(s.am[k])), V.push_back(std::fabs(s.vm[k]));
+  }
+  std::nth_element(A.begin(), A.begin() + static_cast<std::ptrdiff_t>(9 * A.size() / 10), A.end());
+  std::nth_element(V.begin(), V.begin() + static_cast<std::ptrdiff_t>(9 * V.size() / 10), V.end());
+  const double a90 = A[9 * A.size() / 10], v90 = std::max(V[9 * V.size() / 10], 1e-300);
+  const double b_lo = std::isfinite(step) ? step : 1e-6 * (hi - lo), b_hi = 0.5 * (hi - lo);
+  Grids g;
+  g.b.push_back(0);
+  for (int j = 0; j <= 40; ++j) g.b.push_back(b_lo * std::pow(b_hi / b_lo, j / 40.0));
+  for (int j = 0; j <= 16; ++j) g.alpha.push_back(4 * a90 / v90 * j / 16.0), g.beta.push_back(4 * a90 * j / 16.0);
+  return g;
+}
+
+// The shape by coordinate descent from `f` (three sweeps over b, α, β; β only with `coulomb_load`).
+void fit_shape(const Signals& s, ObserverFit& f, const FreeSet& free, bool coulomb_load, bool wide,
+               const std::vector<std::size_t>& samples) {
+  const Grids g = grids_of(s, f.z, wide);
+  f.sse = shape_fit(s, f.z, f.m, free, samples).sse;
+  for (int sweep = 0; sweep < 3; ++sweep) {
+    coordinate(s, f, &Shape::b, g.b, free, samples);
+    coordinate(s, f, &Shape::alpha, g.alpha, free, samples);
+    if (coulomb_load) coordinate(s, f, &Shape::beta, g.beta, free, samples);
+  }
+  Shape rigid = f.z;
+  rigid.b = 0;
+  f.sse_rigid = shape_fit(s, rigid, f.m, free, samples).sse;
+}
+
+// The shape polished by Levenberg–Marquardt (Ceres, numeric derivatives through the observer and
+// the projection): the coordinate scans find the valley, this follows it (b and the load's
+// Coulomb friction trade against each other along it).
+void polish_shape(const Signals& s, ObserverFit& f, const FreeSet& free, bool coulomb_load, const std::vector<std::size_t>& samples) {
+  std::vector<double> x{f.z.b, f.z.alpha, f.z.beta};
+  if (!coulomb_load) x.pop_back();
+  const Theta start = f.m;
+  const std::function<void(const double*, double*)> residual = [&](const double* p, double* r) {
+    const Shape z{std::max(0.0, p[0]), std::max(0.0, p[1]), coulomb_load ? std::max(0.0, p[2]) : 0.0, f.z.compliance};
+    const LinearFit l = shape_fit(s, z, start, free, samples);
+    Theta m = l.m;
+    m[kFL] = m[kTL] = 0;
+    const std::vector<double> all = l.ok ? residuals(s, tied_load(s, z), m) : std::vector<double>(s.size(), 1e3);
+    for (std::size_t i = 0; i < samples.size(); ++i) r[i] = all[samples[i]];
+  };
+  ceres_sigma(residual, samples.size(), x, std::vector<double>(x.size(), 0.0), true, 1e-3);
+  const Shape z{x[0], x[1], coulomb_load ? x[2] : 0.0, f.z.compliance};
+  const LinearFit l = shape_fit(s, z, start, free, samples);
+  if (l.ok && l.sse < f.sse) f.z = z, f.m = l.m, f.sse = l.sse;
+}
+
+// Coarse to fine: the profiled cost of a wrong gap is the mismatch of the impacts' timing, whose
+// basin is as wide as the filter's impulse response; so the shape is found in the band cut at
+// 1/8 of the cut-off first, then refined at 1/4, 1/2 and the cut-off itself.
+ObserverFit fit_shape_coarse_to_fine(const Signals& s, const Theta& start, const FreeSet& free, bool coulomb_load,
+                                     double compliance, const std::vector<std::size_t>& samples) {
+  ObserverFit f;
+  f.m = start;
+  f.z = {0, start[kFL] / start[kJL], start[kTL] / start[kJL]};
+  for (int level = 3; level >= 0; --level) {
+    f.z.compliance = compliance * f.m[kJL];
+    Signals coarse = s;
+    const double cutoff = s.filter.cutoff_hz / std::pow(2.0, level);
+    if (level > 0) {
+      const measurements::ButterworthLowPass filter = measurements::design_butterworth_low_pass(cutoff, s.fs);
+      filter_signals(coarse, filter, detail::drive_filter_edge(filter));
+    }
+    const std::vector<std::size_t> inner = level > 0 ? observer_samples(coarse) : samples;
+    fit_shape(level > 0 ? coarse : s, f, free, coulomb_load, level == 3, inner);
+    polish_shape(level > 0 ? coarse : s, f, free, coulomb_load, inner);
+  }
+  return f;
+}
+
+// σ of b and of the free parameters: Ceres's covariance, numeric derivatives through the observer.
+std::vector<double> observer_sigma(const Signals& s, ObserverFit& f, const FreeSet& free, bool coulomb_load,
+                                   const std::vector<std::size_t>& samples) {
+  std::vector<int> order;
+  for (int i = 0; i < kCount; ++i)
+    if (free[i] || i == kJL || i == kFL || (coulomb_load && i == kTL)) order.push_back(i);
+  std::vector<double> x{f.z.b};
+  for (int i : order) x.push_back(f.m[i]);
+  const std::function<void(const double*, double*)> residual = [&](const double* p, double* r) {
+    Theta m = f.m;
+    for (std::size_t j = 0; j < order.size(); ++j) m[order[j]] = p[j + 1];
+    const double JL = std::max(m[kJL], 1e-12 * f.m[kJL]);
+    const Shape z{std::max(0.0, p[0]), std::max(0.0, m[kFL]) / JL, std::max(0.0, m[kTL]) / JL, f.z.compliance};
+    Theta mt = m;
+    mt[kJL] = JL, mt[kFL] = mt[kTL] = 0;
+    const std::vector<double> all = residuals(s, tied_load(s, z), mt);
+    for (std::size_t i = 0; i < samples.size(); ++i) r[i] = all[samples[i]];
+  };
+  std::vector<double> sigma = ceres_sigma(residual, samples.size(), x, std::vector<double>(x.size(), -INFINITY), false);
+  f.sigma_b = sigma[0];
+  std::vector<double> out(kCount, NAN);
+  for (std::size_t j = 0; j < order.size(); ++j) out[static_cast<std::size_t>(order[j])] = sigma[j + 1];
+  return out;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------ the result
+
+namespace {
+
+// The record a drive with a gap needs: the logged drive and the motor's encoder (theta_load
+// optional), named by file, line 1 and column when missing.
+void check_inputs(const model::CaseSpec& spec, const measurements::MeasuredRecord& data) {
+  const std::string file = data.source.string() + (data.source.extension() == ".mat" ? "" : ":1");  // a CSV's header line
+  if (!data.drive)
+    throw std::invalid_argument(file + ": drive: missing column: a drive with a gap (backlash > 0 in " +
+                                spec.source.filename().string() + ") needs the logged drive (t, theta_motor[, theta_load], drive)");
+  if (!data.theta_motor)
+    throw std::invalid_argument(file + ": theta_motor: missing column: a drive with a gap (backlash > 0 in " +
+                                spec.source.filename().string() + ") needs the motor encoder (t, theta_motor[, theta_load], drive)");
+}
+
+// The motor's reversals (a change of the sign of its motion, rests skipped) and the lost motion
+// at each: the swing of the gap between the midpoints to the neighbouring reversals.
+std::vector<LostMotion> lost_motion(const Signals& s, const std::vector<double>* measured_gap, const std::vector<double>& model_gap) {
+  std::vector<std::size_t> at;
+  std::vector<int> direction;
+  int last = 0;
+  for (std::size_t k = s.begin; k < s.end; ++k) {
+    if (s.sm[k] == 0) continue;
+    if (last != 0 && s.sm[k] != last) at.push_back(k), direction.push_back(s.sm[k]);
+    last = s.sm[k];
+  }
+  std::vector<LostMotion> out;
+  auto swing = [](const std::vector<double>& x, std::size_t a, std::size_t b) {
+    const auto [lo, hi] = std::minmax_element(x.begin() + static_cast<std::ptrdiff_t>(a), x.begin() + static_cast<std::ptrdiff_t>(b));
+    return *hi - *lo;
+  };
+  for (std::size_t i = 0; i < at.size(); ++i) {
+    const std::size_t a = i == 0 ? s.begin : (at[i - 1] + at[i]) / 2;
+    const std::size_t b = i + 1 == at.size() ? s.end : (at[i] + at[i + 1]) / 2;
+    LostMotion l;
+    l.t = s.t[at[i]], l.direction = direction[i];
+    if (measured_gap) l.measured = swing(*measured_gap, a, b);
+    l.model = swing(model_gap, a, b);
+    out.push_back(l);
+  }
+  return out;
+}
+
+ParameterCorrection correction(const std::string& key, double nominal, double fitted, double sigma, bool given_free) {
+  return {key, nominal, fitted, sigma, nominal != 0 ? fitted / nominal : NAN, given_free};
+}
+
+bool listed(const model::CaseSpec& spec, const std::string& key) {
+  return std::find(spec.fit_free.begin(), spec.fit_free.end(), key) != spec.fit_free.end();
+}
+
+// The nominal parameters fitted, as parameter corrections (the backlash first).
+void corrections_of(const model::CaseSpec& spec, const Theta& given, const Theta& m, const std::vector<double>& sigma,
+                    const FreeSet& free, double b, double sigma_b, TwoBodyFindings& f) {
+  f.parameter_corrections.push_back(correction("backlash", model::to_double(spec.backlash), b, sigma_b, listed(spec, "backlash")));
+  for (int i : {kJL, kFL, kJm, kFm})
+    if (free[i]) f.parameter_corrections.push_back(correction(kName[i], given[i], m[i], sigma[static_cast<std::size_t>(i)], listed(spec, kName[i])));
+}
+
+// σ of the summed equation's free parameters (both encoders: the load measured).
+std::vector<double> summed_sigma(const Signals& s, const LoadSide& l, Theta& m, const FreeSet& free, const std::vector<std::size_t>& samples) {
+  std::vector<int> order;
+  for (int i = 0; i < kCount; ++i)
+    if (free[i]) order.push_back(i);
+  std::vector<double> x;
+  for (int i : order) x.push_back(m[i]);
+  const std::function<void(const double*, double*)> residual = [&](const double* p, double* r) {
+    Theta t = m;
+    for (std::size_t j = 0; j < order.size(); ++j) t[order[j]] = p[j];
+    const std::vector<double> all = residuals(s, l, t);
+    for (std::size_t i = 0; i < samples.size(); ++i) r[i] = all[samples[i]];
+  };
+  const std::vector<double> sigma = ceres_sigma(residual, samples.size(), x, std::vector<double>(x.size(), -INFINITY), false);
+  std::vector<double> out(kCount, NAN);
+  for (std::size_t j = 0; j < order.size(); ++j) out[static_cast<std::size_t>(order[j])] = sigma[j];
+  return out;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------ the two routes
+
+namespace {
+
+struct Fitted {
+  Theta given{}, nominal{}, m{};
+  FreeSet free{};
+  std::vector<double> sigma;
+  double given_b = 0, b = 0, sigma_b = NAN;
+  double compliance = 0;  // 1/kc of the file's mesh (0: rigid), held with the motor encoder alone
+  std::vector<double> r_given, r_nominal, r_after;
+  std::vector<std::size_t> all;
+};
+
+// Both encoders: the summed equation with the load measured; the gap read on its faces.
+void both_encoders(const Signals& s, const DriveOptions& options, Fitted& f, DriveDiscrepancyResult& result, TwoBodyFindings& two) {
+  const LoadSide l = load_side(s, s.qL, true);
+  Search w{s, l, compared_samples(s, l, true), {}, {}, options};
+  split_blocks(s, w.all, w.fit, w.holdout);
+  const LinearFit nominal = solve(s, l, f.given, f.free, w.all);
+  if (!nominal.ok) throw std::invalid_argument(s.name + ": the record does not fit a physical drive with the load's parameters free (JL > 0, FL >= 0)");
+  f.nominal = nominal.m;
+  f.m = name_effects(w, f.nominal, f.free, result);
+  f.sigma = summed_sigma(s, l, f.m, f.free, w.all);
+  f.r_given = residuals(s, l, f.given), f.r_nominal = residuals(s, l, f.nominal), f.r_after = residuals(s, l, f.m);
+  f.all = w.all;
+  // The gap on its faces, with the load's inverse dynamics R of the fitted model.
+  std::vector<double> x(s.size()), R(s.size());
+  for (std::size_t k = 0; k < s.size(); ++k) x[k] = s.qL[k] - s.qm[k];
+  const std::vector<double> xf = measurements::zero_phase_filter(x, s.filter);
+  for (std::size_t k = 0; k < s.size(); ++k) R[k] = f.m[kJL] * l.aL[k] + f.m[kFL] * l.vL[k] + f.m[kTL] * l.sL_f[k];
+  GapFit rigid = fit_gap(s, xf, R, false);
+  GapFit g = rigid;
+  if (!std::isfinite(g.sse)) throw std::invalid_argument(s.name + ": theta_load: the gap theta_load - theta_motor shows no contact plateau to read the backlash on");
+  GapFit compliant = fit_gap(s, xf, R, true);
+  const double n_eff = static_cast<double>(rigid.contact.size()) / tau_int_on(xf, rigid.contact);
+  Candidate c;
+  c.effect = "compliance";
+  if (std::isfinite(compliant.sse) && compliant.contact.size() > 10) {
+    c.delta_bic = n_eff * std::log(std::max(compliant.sse, 1e-300) / std::max(rigid.sse, 1e-300)) + std::log(n_eff);
+    c.at_range_edge = !(compliant.c > 0);
+    c.decisive = c.delta_bic < -options.decisive_bic && !c.at_range_edge;
+    if (c.decisive) g = compliant;
+  } else {
+    c.failure = "too few samples in contact", c.delta_bic = INFINITY;
+  }
+  gap_sigma(xf, R, g);
+  if (g.c > 0) c.parameters = {{"stiffness", 1 / g.c, g.sigma_c / (g.c * g.c)}};
+  result.rounds.push_back({c});
+  if (c.decisive) result.effects.push_back(c), result.corrected_effects.mesh_stiffness = 1 / g.c;
+  f.b = g.b, f.sigma_b = g.sigma_b;
+  two.gap_offset = g.x0, two.contact_fraction = g.contact_fraction;
+  std::vector<double> model_gap = load_observer(s.qmf, s.vm, s.am, s.fs, g.b, g.x0, f.m[kJL], f.m[kFL], f.m[kTL]);
+  for (std::size_t k = 0; k < s.size(); ++k) model_gap[k] -= g.c * R[k];
+  two.reversals = lost_motion(s, &xf, model_gap);
+  two.loop_motor = s.qm, two.loop_load = s.qL, two.loop_model.resize(s.size());
+  for (std::size_t k = 0; k < s.size(); ++k) two.loop_model[k] = s.qm[k] + model_gap[k];
+}
+
+// The motor encoder alone: the load observed for a trial shape; the shape by the profiled cost,
+// first with every friction and the offset free (so that the observer moves as the load does),
+// then the effects named on the observed load, then the shape again with the named ones.
+void motor_encoder(const Signals& s, const DriveOptions& options, Fitted& f, DriveDiscrepancyResult& result, TwoBodyFindings& two) {
+  const std::vector<std::size_t> samples = observer_samples(s);
+  FreeSet everything = f.free;
+  for (const auto& [effect, which] : effect_columns()) everything[which] = which != kTL && f.given[which] == 0;
+  ObserverFit first = fit_shape_coarse_to_fine(s, f.given, everything, true, f.compliance, samples);
+  if (!std::isfinite(first.sse)) throw std::invalid_argument(s.name + ": the record does not fit a physical drive with the load's parameters free (JL > 0, FL >= 0)");
+  Theta nominal = first.m;
+  for (int i : {kTm, kTL, kT0}) nominal[i] = f.given[i];
+  const LoadSide l = observed_load(s, first.z.b, first.m, f.compliance);
+  const LinearFit best_nominal = solve(s, l, nominal, f.free, samples);
+  f.nominal = best_nominal.ok ? best_nominal.m : nominal;
+  Search w{s, l, samples, {}, {}, options};
+  split_blocks(s, w.all, w.fit, w.holdout);
+  name_effects(w, f.nominal, f.free, result);
+  const bool coulomb_load = f.free[kTL] || f.given[kTL] > 0;
+  ObserverFit final_fit = first;
+  final_fit.m = f.nominal;
+  fit_shape(s, final_fit, f.free, coulomb_load, false, samples);
+  f.sigma = observer_sigma(s, final_fit, f.free, coulomb_load, samples);
+  f.m = final_fit.m, f.b = final_fit.z.b, f.sigma_b = final_fit.sigma_b;
+  f.r_given = residuals(s, observed_load(s, f.given_b, f.given, f.compliance), f.given);
+  f.r_nominal = residuals(s, l, f.nominal);
+  f.r_after = residuals(s, observed_load(s, f.b, f.m, f.compliance), f.m);
+  f.all = samples;
+  two.torque_rms_rigid = std::sqrt(final_fit.sse_rigid / static_cast<double>(std::max<std::size_t>(1, samples.size())));
+  two.contact_fraction = NAN;
+  const std::vector<double> model_gap = load_observer(s.qmf, s.vm, s.am, s.fs, f.b, 0, f.m[kJL], f.m[kFL], f.m[kTL], f.compliance);
+  two.reversals = lost_motion(s, nullptr, model_gap);
+}
+
+}  // namespace
+
+namespace {
+
+// The status (as the rigid workflow's): effects named; else a nominal parameter corrected beyond
+// three σ (and 5 %); else the residual at the noise, or unexplained.
+Status status_of(const DriveDiscrepancyResult& r, const TwoBodyFindings& two) {
+  if (!r.effects.empty()) return Status::EffectFound;
+  for (const ParameterCorrection& c : two.parameter_corrections) {
+    const double change = std::fabs(c.fitted - c.nominal);
+    if (change > 3 * c.uncertainty && change > 0.05 * std::fabs(c.nominal)) return Status::ParametersCorrected;
+  }
+  return r.rms_before <= kNoiseFactor * r.noise ? Status::NoDiscrepancy : Status::Unexplained;
+}
+
+// The scores and the traces for the figures.
+void fill_result(const Signals& s, const Fitted& f, DriveDiscrepancyResult& r) {
+  r.rms_given = rms_on(f.r_given, f.all), r.rms_before = rms_on(f.r_nominal, f.all), r.rms_after = rms_on(f.r_after, f.all);
+  r.tau_int_before = tau_int_on(f.r_nominal, f.all), r.tau_int_after = tau_int_on(f.r_after, f.all);
+  std::vector<double> inner;
+  for (std::size_t k : f.all) inner.push_back(f.r_after[k]);
+  r.noise = estimate_noise(inner);
+  for (Candidate& c : r.effects) {
+    const auto it = std::find_if(effect_columns().begin(), effect_columns().end(), [&](const auto& e) { return e.first == c.effect; });
+    if (it != effect_columns().end()) c.parameters = {{"torque", f.m[it->second], f.sigma[static_cast<std::size_t>(it->second)]}};
+  }
+  r.corrected_effects.coulomb_motor = f.m[kTm], r.corrected_effects.coulomb_load = f.m[kTL];
+  r.corrected_effects.torque_offset = f.m[kT0];
+  r.t = s.t, r.velocity = s.vm, r.position = s.qm;
+  r.torque_measured = s.Uf;
+  r.torque_nominal.resize(s.size()), r.torque_corrected.resize(s.size());
+  for (std::size_t k = 0; k < s.size(); ++k) r.torque_nominal[k] = s.Uf[k] - f.r_nominal[k], r.torque_corrected[k] = s.Uf[k] - f.r_after[k];
+  r.estimation = {s.name, static_cast<int>(s.size()), r.rms_before, r.rms_after, NAN, NAN, 0};
+}
+
+}  // namespace
+
+DriveDiscrepancyResult find(const model::CaseSpec& spec, const measurements::MeasuredRecord& data, const DriveOptions& options) {
+  const std::string where = spec.source.filename().string();
+  check_inputs(spec, data);
+  DriveDiscrepancyResult result;
+  const numeric::Parameters given = numeric::parameters_of(spec);
+  const numeric::Effects file_effects = numeric::effects_of(spec);
+  if (file_effects.delay > 0 || file_effects.saturating() || file_effects.restitution != 0 || file_effects.stribeck())
+    throw std::invalid_argument(where + ": effects: a drive with a gap is compared with Coulomb friction on either body, a torque offset "
+                                "and mesh compliance; delay, saturation, restitution and Stribeck friction are not yet part of it");
+  const Signals s = prepare(spec, data, options, result);
+  Fitted f;
+  f.given = given_theta(given, file_effects);
+  f.given_b = given.backlash;
+  f.compliance = file_effects.compliant() ? 1 / file_effects.mesh_stiffness : 0;
+  f.free = nominal_free_of(spec, where);
+  for (int i : {kTm, kTL, kT0}) f.free[i] = false;
+  result.corrected_effects = file_effects;
+  TwoBodyFindings two;
+  two.load_encoder = s.load_logged();
+  two.method = two.load_encoder ? "gap observed (both encoders)" : "load observer (motor encoder alone)";
+  if (two.load_encoder) both_encoders(s, options, f, result, two);
+  else motor_encoder(s, options, f, result, two);
+  corrections_of(spec, f.given, f.m, f.sigma, f.free, f.b, f.sigma_b, two);
+  two.reversals_count = static_cast<int>(two.reversals.size());
+  if (!two.load_encoder && two.reversals_count < 5)
+    throw std::invalid_argument(data.source.string() + ": the motor reverses " + std::to_string(two.reversals_count) +
+                                " times: with the motor encoder alone the backlash needs at least 5 reversals (or log theta_load)");
+  two.rigid = !(f.b > 3 * f.sigma_b);
+  fill_result(s, f, result);
+  result.given = given;
+  result.nominal = result.parameters = given;
+  result.nominal.JL = f.nominal[kJL], result.nominal.FL = f.nominal[kFL], result.nominal.Jm = f.nominal[kJm], result.nominal.Fm = f.nominal[kFm];
+  result.parameters.JL = f.m[kJL], result.parameters.FL = f.m[kFL], result.parameters.Jm = f.m[kJm], result.parameters.Fm = f.m[kFm];
+  result.parameters.backlash = f.b;
+  result.status = status_of(result, two);
+  result.two_body = std::move(two);
+  return result;
+}
+
+}  // namespace backlash::discrepancy::two_body

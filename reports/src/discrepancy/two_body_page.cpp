@@ -1,0 +1,80 @@
+// The measured-drive workflow's results on a drive with a gap (discrepancy/two_body_drive.hpp):
+// its JSON keys, figures (lost motion at each reversal, the hysteresis loop) and page sections.
+#include "two_body_page.hpp"
+
+#include "page_json.hpp"
+#include "plots.hpp"
+
+#include <cmath>
+
+namespace backlash::discrepancy::detail {
+
+nlohmann::json two_body_corrections_json(const TwoBodyFindings& two) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const ParameterCorrection& c : two.parameter_corrections)
+    out.push_back({{"key", c.key},
+                   {"nominal", c.nominal},
+                   {"fitted", c.fitted},
+                   {"sigma", json_number(c.uncertainty)},
+                   {"ratio", json_number(c.ratio)},
+                   {"given_free", c.given_free}});
+  return out;
+}
+
+nlohmann::json two_body_json(const TwoBodyFindings& two) {
+  nlohmann::json reversals = nlohmann::json::array();
+  for (const LostMotion& l : two.reversals)
+    reversals.push_back({{"t", l.t}, {"direction", l.direction}, {"measured", json_number(l.measured)}, {"model", json_number(l.model)}});
+  return {{"method", two.method},
+          {"load_encoder", two.load_encoder},
+          {"rigid", two.rigid},
+          {"gap_offset", two.gap_offset},
+          {"contact_fraction", json_number(two.contact_fraction)},
+          {"torque_rms_rigid", json_number(two.torque_rms_rigid)},
+          {"reversals", reversals}};
+}
+
+void two_body_figures(const TwoBodyFindings& two, std::vector<reports::Plot>& figures) {
+  std::vector<double> index, measured, model;  // line_plot copies the points
+  for (std::size_t i = 0; i < two.reversals.size(); ++i) {
+    index.push_back(static_cast<double>(i + 1));
+    measured.push_back(two.reversals[i].measured);
+    model.push_back(two.reversals[i].model);
+  }
+  std::vector<Curve> lost{{"model", "#2a7", &index, &model}};
+  if (two.load_encoder) lost.insert(lost.begin(), Curve{"measured", "#222", &index, &measured});
+  figures.push_back(line_plot("lost_motion", "Lost motion at each reversal of the motor (the gap's swing face to face)",
+                              "reversal", "lost motion [rad]", lost));
+  if (!two.load_encoder) return;
+  figures.push_back(line_plot("hysteresis_loop", "Hysteresis loop: the load against the motor", "motor position [rad]",
+                              "load position [rad]",
+                              {{"measured", "#222", &two.loop_motor, &two.loop_load},
+                               {"model (load observer on the measured motor)", "#2a7", &two.loop_motor, &two.loop_model, true}}));
+}
+
+void two_body_page(std::ostringstream& md, const TwoBodyFindings& two, bool drawn) {
+  md << "## The gap\n\nA drive with a gap: the motor and the load as two bodies, the logged drive on the motor; method: "
+     << two.method << " (docs/discrepancy.md, \"Measured drive with a gap\"). " << two.reversals_count
+     << " reversals of the motor.\n\n| parameter | nominal | fitted | ± (1σ) | ratio |\n|---|---|---|---|---|\n";
+  for (const ParameterCorrection& c : two.parameter_corrections)
+    md << "| " << c.key << " | " << number(c.nominal) << " | " << number(c.fitted) << " | " << number(c.uncertainty) << " | "
+       << number(c.ratio) << " |\n";
+  if (two.rigid) md << "\n**A rigid drive**: the backlash is not distinguishable from 0 (within 3σ).\n";
+  if (two.load_encoder)
+    md << "\nThe encoders' relative zero: " << number(two.gap_offset) << "; " << number(100 * two.contact_fraction)
+       << " % of the compared samples in certain contact (the backlash is read there).\n";
+  else
+    md << "\nTorque RMS of the same fit with no gap: " << number(two.torque_rms_rigid) << ".\n";
+  md << "\n### Lost motion at each reversal\n\n| reversal | t [s] | direction | measured | model |\n|---|---|---|---|---|\n";
+  for (std::size_t i = 0; i < two.reversals.size() && i < 20; ++i) {
+    const LostMotion& l = two.reversals[i];
+    md << "| " << i + 1 << " | " << number(l.t) << " | " << (l.direction > 0 ? "forward" : "backward") << " | "
+       << (std::isfinite(l.measured) ? number(l.measured) : std::string("(motor encoder alone)")) << " | " << number(l.model) << " |\n";
+  }
+  if (two.reversals.size() > 20) md << "\n(the first 20 of " << two.reversals.size() << "; all in discrepancy.json)\n";
+  if (!drawn) return;
+  md << "\n![lost motion](lost_motion.svg)\n\n";
+  if (two.load_encoder) md << "![hysteresis loop](hysteresis_loop.svg)\n\n";
+}
+
+}  // namespace backlash::discrepancy::detail
