@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <set>
 #include <thread>
 
 namespace backlash::discrepancy::detail {
@@ -19,8 +20,8 @@ Scores score(const Observations& o, const std::vector<std::vector<double>>& trac
   Scores s;
   const std::vector<double> fit = residuals(o, traces, o.fit_indices);
   const std::vector<double> held = residuals(o, traces, o.holdout_indices);
-  s.sse_fit = sum_of_squares(fit);
-  s.sse_holdout = sum_of_squares(held);
+  s.sse_fit = robust_sum(fit);
+  s.sse_holdout = robust_sum(held);
   s.sse = s.sse_fit + s.sse_holdout;
   s.n_fit = fit.size();
   s.n_holdout = held.size();
@@ -104,8 +105,13 @@ void judge(Trial& t, const Search& s, int current_k) {
   t.result.delta_bic = t.result.bic - s.scores.bic(current_k);
   // Decisive on both: the BIC, and the held-out samples — they must shrink, or, when the model
   // already meets them at the noise level, at least not get worse.
+  // Shrinking means to at most decisive_holdout of the current RMS, or by as much as the held-out
+  // samples' own likelihood ratio calls decisive (n_eff·ln(SSE ratio) < −decisive_bic: a large
+  // gap that a real effect closes only in part, while another remains).
   const double held = s.scores.rms_holdout();
+  const double n_held = std::max(1.0, static_cast<double>(sc.n_holdout) / s.o.tau_int);
   const bool confirmed = t.result.rms_holdout < options.decisive_holdout * held ||
+                         n_held * 2 * std::log(t.result.rms_holdout / held) < -options.decisive_bic ||
                          (held <= options.noise_level && t.result.rms_holdout <= 1.02 * held);
   // A parameter pinned at the edge of its range cannot be told from that limit: not decisive.
   t.result.at_range_edge = std::any_of(t.fit.u.begin(), t.fit.u.end(), [](double u) { return u < 1e-3 || u > 1 - 1e-3; });
@@ -214,30 +220,95 @@ std::string combination_problem(const std::string& a, const std::string& b) {
   return "";
 }
 
-// Every pair of the round's best four, fitted together
-// from their single fits and judged with both parameters' penalty.  The best decisive pair, or nothing.
+// Runs job(i) for i < n on the options' threads (each index once; the results stay in index order).
+template <typename Job>
+void parallel_for(std::size_t n, int threads, Job job) {
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    for (std::size_t i = next++; i < n; i = next++) job(i);
+  };
+  std::vector<std::thread> pool;
+  for (int k = 1; k < std::max(1, threads); ++k) pool.emplace_back(work);
+  work();
+  for (std::thread& th : pool) th.join();
+}
+
+// A partner screened for a single candidate S: the best point of its scan with S at S's fit.
+struct Screened {
+  const Trial* single = nullptr;
+  const Trial* partner = nullptr;
+  std::vector<double> u;  ///< the partner's best scan point
+  double sse = INFINITY;
+  std::string problem;    ///< why the two cannot be combined
+};
+
+// The partner's scan, every point on the fitted samples with `single` at its fit.
+void screen(Screened& x, Search& s) {
+  x.problem = combination_problem(x.single->result.effect, x.partner->result.effect);
+  if (!x.problem.empty()) return;
+  const EffectCandidate& c = x.partner->candidate;
+  long work = 0;  // a quarter of a single candidate's budget (a stiff mesh with a delay is slow)
+  for (const std::vector<double>& u : c.scan()) {
+    if (s.simulator.budget_reached() || work >= s.options.candidate_work / 4) return;
+    std::vector<double> values;
+    for (std::size_t k = 0; k < u.size(); ++k) values.push_back(c.ranges[k].value(u[k]));
+    long cost = 0;
+    const auto traces = s.simulator.traces(c.apply(x.single->point, values), s.o.size(), nullptr, &cost);
+    work += cost;
+    if (!traces) continue;
+    const double sse = robust_sum(residuals(s.o, *traces, s.o.fit_indices));
+    if (sse < x.sse) x.sse = sse, x.u = u;
+  }
+}
+
+// "The best single plus one": each of the round's best three singles S (fitted, by BIC) with
+// every other candidate screened at S's fit (a scan of the partner alone); the two best partners
+// of each S fitted together with it (from S's fit and the partner's best scan point; a quarter
+// of a single candidate's budget) and judged with both parameters' penalty.  Two contact laws
+// cannot be combined: refused by name in the round's list.  The best decisive pair, or nothing.
 std::optional<Trial> best_pair(Search& s, const std::vector<Trial>& singles, double departure, std::vector<Candidate>& round) {
-  std::vector<const Trial*> top;
+  std::vector<const Trial*> fitted;
   for (const Trial& t : singles)
-    if (t.fit.ok && top.size() < 4) top.push_back(&t);
-  std::optional<Trial> best;
-  for (std::size_t i = 0; i < top.size(); ++i)
-    for (std::size_t j = i + 1; j < top.size(); ++j) {
-      Trial pair;
-      pair.candidate = combined({top[i]->candidate, top[j]->candidate});
-      if (const std::string problem = combination_problem(top[i]->result.effect, top[j]->result.effect); !problem.empty()) {
-        pair.result.effect = pair.candidate.effect;
-        pair.result.failure = problem;
-        pair.result.bic = pair.result.rms = pair.result.rms_holdout = INFINITY;
-        round.push_back(pair.result);
-        continue;
-      }
-      std::vector<double> start = top[i]->fit.u;
-      start.insert(start.end(), top[j]->fit.u.begin(), top[j]->fit.u.end());
-      run_trial(pair, s, pair.candidate.effect, departure, &start);
-      round.push_back(pair.result);
-      if (pair.result.decisive && (!best || pair.result.bic < best->result.bic)) best = std::move(pair);
+    if (t.fit.ok) fitted.push_back(&t);
+  std::vector<Screened> screened;
+  for (std::size_t i = 0; i < std::min<std::size_t>(3, fitted.size()); ++i)
+    for (const Trial* partner : fitted)
+      if (partner != fitted[i]) screened.push_back({fitted[i], partner, {}, INFINITY, ""});
+  parallel_for(screened.size(), s.options.threads, [&](std::size_t i) { screen(screened[i], s); });
+  std::vector<const Screened*> chosen;
+  std::set<std::string> seen;
+  for (std::size_t i = 0; i < std::min<std::size_t>(3, fitted.size()); ++i) {
+    std::vector<const Screened*> mine;
+    for (const Screened& x : screened)
+      if (x.single == fitted[i] && std::isfinite(x.sse)) mine.push_back(&x);
+    std::sort(mine.begin(), mine.end(), [](const Screened* a, const Screened* b) { return a->sse < b->sse; });
+    for (std::size_t k = 0; k < std::min<std::size_t>(2, mine.size()); ++k) {
+      const std::string a = mine[k]->single->result.effect, b = mine[k]->partner->result.effect;
+      if (seen.insert(std::min(a, b) + " + " + std::max(a, b)).second) chosen.push_back(mine[k]);
     }
+  }
+  for (const Screened& x : screened)  // refused combinations, by name
+    if (!x.problem.empty() && seen.insert(std::min(x.single->result.effect, x.partner->result.effect) + " + " +
+                                          std::max(x.single->result.effect, x.partner->result.effect))
+                                  .second) {
+      Candidate refused;
+      refused.effect = x.single->result.effect + " + " + x.partner->result.effect;
+      refused.failure = x.problem;
+      refused.bic = refused.rms = refused.rms_holdout = INFINITY;
+      round.push_back(refused);
+    }
+  std::vector<Trial> pairs(chosen.size());
+  parallel_for(chosen.size(), s.options.threads, [&](std::size_t i) {
+    pairs[i].candidate = combined({chosen[i]->single->candidate, chosen[i]->partner->candidate});
+    std::vector<double> start = chosen[i]->single->fit.u;
+    start.insert(start.end(), chosen[i]->u.begin(), chosen[i]->u.end());
+    run_trial(pairs[i], s, pairs[i].candidate.effect, departure, &start);
+  });
+  std::optional<Trial> best;
+  for (Trial& pair : pairs) {
+    round.push_back(pair.result);
+    if (pair.result.decisive && (!best || pair.result.bic < best->result.bic)) best = std::move(pair);
+  }
   return best;
 }
 

@@ -6,6 +6,8 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <mutex>
 #include <numeric>
 #include <stdexcept>
@@ -380,6 +382,10 @@ DiscrepancyResult find_discrepancy(const model::CaseSpec& spec, const measuremen
   result.distinguishing_experiment = s.experiment;
   result.status = status_of(s, result.gap_after <= result.noise_estimate.at_noise, nominal_at_noise);
   result.simulations = simulator.simulations();
+  result.work = simulator.work();
+  if (std::getenv("BACKLASH_DEBUG_FITS"))
+    std::fprintf(stderr, "discrepancy: %d simulations, %d of them kept ones, work %ld\n", simulator.simulations(),
+                 simulator.cache_hits(), simulator.work());
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }

@@ -192,6 +192,7 @@ struct DiscrepancyResult {
   numeric::Effects corrected_effects;
   std::vector<double> t, theta_measured, theta_nominal, theta_corrected;
   int simulations = 0;
+  long work = 0;  ///< the simulations' work as the budget counts it (DiscrepancyOptions::total_work)
   double seconds = 0;
 };
 
