@@ -90,6 +90,17 @@ void flag_spikes(const std::vector<double>& r, double white_sigma, std::vector<c
     const double miss = std::min({std::fabs(r[i] - left), std::fabs(r[i] - right), std::fabs(r[i] - middle)});
     if (miss > threshold) skip[i] = 1;
   }
+  // Two spikes side by side (each one's neighbour is the other: the test above misses them):
+  // both missed by the lines from either side (one and two samples ahead) and by the
+  // interpolation across the two.
+  for (std::size_t i = 2; i + 3 < r.size(); ++i) {
+    if (skip[i] || skip[i + 1] || skip[i - 1] || skip[i + 2]) continue;
+    const double a = r[i - 2], b = r[i - 1], c = r[i + 2], d = r[i + 3];
+    const double first = std::min({std::fabs(r[i] - (2 * b - a)), std::fabs(r[i] - (3 * c - 2 * d)), std::fabs(r[i] - (2 * b + c) / 3)});
+    const double second =
+        std::min({std::fabs(r[i + 1] - (3 * b - 2 * a)), std::fabs(r[i + 1] - (2 * c - d)), std::fabs(r[i + 1] - (b + 2 * c) / 3)});
+    if (first > threshold && second > threshold) skip[i] = skip[i + 1] = 1;
+  }
 }
 
 }  // namespace backlash::discrepancy::detail

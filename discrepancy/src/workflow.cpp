@@ -232,7 +232,7 @@ std::vector<Outlier> outliers_of(const Observations& o, const std::vector<std::v
       const double size = (r(i) - 0.5 * (r(i - 1) + r(i + 1))) / o.sigma[c];
       if (c == 0 || std::fabs(size) > std::fabs(out.back().size)) {
         if (c > 0) out.pop_back();
-        out.push_back({o.t[i], names[o.which[c]], size});
+        out.push_back({i, o.t[i], names[o.which[c]], size});
       }
     }
   }

@@ -125,6 +125,7 @@ struct ParameterCorrection {
 
 /// A sample the fit gives no weight: an isolated spike (docs/discrepancy.md, "Noise").
 struct Outlier {
+  std::size_t index = 0;  ///< the sample's row in the record, from 0
   double t = 0;
   std::string column;  ///< "theta_out", "theta_motor", "theta_load"
   double size = 0;     ///< its distance from its neighbours' median, in units of σ
@@ -157,7 +158,7 @@ struct DiscrepancyOptions {
   /// at most 20 s on one core (bench/time_discrepancy_records.sh).
   /// (A delayed model's simulation counts more: 400 per radian of its fastest oscillation over the
   /// record, about 12000 for a delayed case V over 30 s — it is integrated numerically.)
-  long total_work = 50'000'000;
+  long total_work = 80'000'000;
   /// The nominal parameters tried as corrections (default: all; [fit] fixed removes some).
   std::vector<std::string> parameters = parameter_candidates();
   double ambiguity_bic = 2;       ///< two explanations whose BIC differ by less are alike
