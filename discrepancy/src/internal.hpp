@@ -178,8 +178,9 @@ double quantum_of(const std::vector<double>& y);
 
 /// Isolated spikes of a residual: samples that the linear extrapolations from either side and
 /// the interpolation between their neighbours all miss by more than 6·√6 white σ (a kink — an
-/// impact — is met by one of the three; a spike by none), and two spikes side by side (the same
-/// three predictions from outside the pair).  Flags them in `skip`.
+/// impact — is met by one of the three; a spike by none), and two spikes side by side (their
+/// mean missed by 10 white σ by the same three predictions from outside the pair).  Flags them in
+/// `skip`.
 void flag_spikes(const std::vector<double>& r, double white_sigma, std::vector<char>& skip);
 
 }  // namespace backlash::discrepancy::detail

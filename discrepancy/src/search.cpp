@@ -57,7 +57,10 @@ namespace {
 
 /// The candidates fitted in a round after the first (the rest screened out by their scans).
 constexpr std::size_t kRoundFits = 6;
-/// The partners fitted with each of a round's best three singles (screened at its fit: a partner
+/// The singles a pair is built on: the round's best five by BIC (a pair's first effect can rank
+/// fourth or fifth alone, behind parameters that absorb part of both).
+constexpr std::size_t kSingles = 5;
+/// The partners fitted with each of a round's best kSingles singles (screened at its fit: a partner
 /// that only a joint fit shows — its single fit biased by the missing partner — can rank low there).
 constexpr std::size_t kPartners = 8;
 
@@ -345,7 +348,7 @@ void screen(Screened& x, Search& s, const Eigen::MatrixXd& single) {
   if (x.problem.empty()) x.sse = best_scan_point(s, x.partner->candidate, x.single->point, single, x.u);
 }
 
-// "The best single plus one": each of the round's best three singles S (fitted, by BIC) with
+// "The best single plus one": each of the round's best kSingles singles S (fitted, by BIC) with
 // every other candidate screened at S's fit (a scan of the partner alone); the kPartners best partners
 // of each S fitted together with it (from S's fit and the partner's best scan point; a quarter
 // of a single candidate's budget) and judged with both parameters' penalty.  Two contact laws
@@ -355,10 +358,10 @@ std::optional<Trial> best_pair(Search& s, const std::vector<Trial>& singles, dou
   for (const Trial& t : singles)
     if (t.fit.ok) fitted.push_back(&t);
   std::vector<Screened> screened;
-  for (std::size_t i = 0; i < std::min<std::size_t>(3, fitted.size()); ++i)
+  for (std::size_t i = 0; i < std::min(kSingles, fitted.size()); ++i)
     for (const Trial* partner : fitted)
       if (partner != fitted[i]) screened.push_back({fitted[i], partner, {}, INFINITY, ""});
-  std::vector<Eigen::MatrixXd> moving(std::min<std::size_t>(3, fitted.size()));  // each S's directions (with the named)
+  std::vector<Eigen::MatrixXd> moving(std::min(kSingles, fitted.size()));  // each S's directions (with the named)
   parallel_for(moving.size(), s.options.threads, [&](std::size_t i) {
     moving[i] = named_directions(s, &fitted[i]->candidate, &fitted[i]->fit.u);
   });
@@ -368,7 +371,7 @@ std::optional<Trial> best_pair(Search& s, const std::vector<Trial>& singles, dou
   });
   std::vector<const Screened*> chosen;
   std::set<std::string> seen;
-  for (std::size_t i = 0; i < std::min<std::size_t>(3, fitted.size()); ++i) {
+  for (std::size_t i = 0; i < std::min(kSingles, fitted.size()); ++i) {
     std::vector<const Screened*> mine;
     for (const Screened& x : screened)
       if (x.single == fitted[i] && std::isfinite(x.sse)) mine.push_back(&x);
