@@ -126,8 +126,9 @@ double sum_of_squares(const std::vector<double>& r);
 /// The scale of the robust loss, in units of the noise's σ (the residuals are weighted by 1/σ):
 /// a residual beyond it counts linearly, not squared (docs/discrepancy.md, "Outliers").
 inline constexpr double kHuberScale = 3;
-/// Σ ρ(r²) with Huber's ρ at kHuberScale (ceres::HuberLoss): what every fit and score of a step
-/// record minimises — an outlier the spike test does not catch pulls no fit far.
+/// Σ ρ(r²) with Huber's ρ at kHuberScale (ceres::HuberLoss): what every fit of a step record
+/// minimises — an outlier the spike test does not catch pulls no fit far.  (The scores — BIC,
+/// held-out RMS, gaps — stay sums of squares: a systematic gap of 25σ is not an outlier.)
 double robust_sum(const std::vector<double>& r);
 
 /// A candidate fitted: its parameters, and its scores.

@@ -22,8 +22,8 @@ Scores score(const Observations& o, const std::vector<std::vector<double>>& trac
   Scores s;
   const std::vector<double> fit = residuals(o, traces, o.fit_indices);
   const std::vector<double> held = residuals(o, traces, o.holdout_indices);
-  s.sse_fit = robust_sum(fit);
-  s.sse_holdout = robust_sum(held);
+  s.sse_fit = sum_of_squares(fit);
+  s.sse_holdout = sum_of_squares(held);
   s.sse = s.sse_fit + s.sse_holdout;
   s.n_fit = fit.size();
   s.n_holdout = held.size();
