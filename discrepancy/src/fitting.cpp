@@ -31,8 +31,61 @@ void Simulator::prepare(const std::vector<ModelPoint>& points) {
   family_.validate_samples(samples);
 }
 
+namespace {
+
+/// A model point and a length as bytes: the key of a kept simulation.
+std::string key_of(const ModelPoint& m, std::size_t samples) {
+  const double p[] = {m.p.Jm, m.p.Fm, m.p.JL, m.p.FL, m.p.K, m.p.theta_R, m.p.backlash,
+                      static_cast<double>(m.p.measured_at), static_cast<double>(samples)};
+  std::string key(reinterpret_cast<const char*>(p), sizeof p);
+  key.append(reinterpret_cast<const char*>(&m.e), sizeof m.e);  // Effects: doubles only
+  return key;
+}
+
+constexpr std::size_t kKeptSimulations = 256;
+
+}  // namespace
+
+std::optional<Simulator::Kept> Simulator::recall(const std::string& key) {
+  std::lock_guard<std::mutex> lock(cache_mutex_);
+  const auto found = cache_.find(key);
+  if (found == cache_.end()) return std::nullopt;
+  return *found->second;
+}
+
+void Simulator::keep(const std::string& key, const Kept& kept) {
+  std::lock_guard<std::mutex> lock(cache_mutex_);
+  if (!cache_.emplace(key, std::make_shared<const Kept>(kept)).second) return;
+  cache_order_.push_back(key);
+  if (cache_order_.size() > kKeptSimulations) {
+    cache_.erase(cache_order_.front());
+    cache_order_.erase(cache_order_.begin());
+  }
+}
+
+// A model point simulated before at this length is not simulated again (a fit's bracket, a
+// refit from the same point, a candidate judged after its fit): its work is charged all the same,
+// so the budget — a count — does not depend on which thread simulated it first.
 std::optional<std::vector<std::vector<double>>> Simulator::traces(const ModelPoint& m, std::size_t samples,
-                                                                  std::vector<numeric::SimulationEvent>* events) {
+                                                                  std::vector<numeric::SimulationEvent>* events, long* cost) {
+  samples = std::min(samples, data_.size());
+  const std::string key = key_of(m, samples);
+  std::optional<Kept> kept = recall(key);
+  if (kept) {
+    ++simulations_, ++hits_;
+    work_ += kept->cost;
+  } else {
+    kept.emplace();
+    kept->traces = simulate(m, samples, &kept->events, &kept->cost);
+    if (kept->cost > 0) keep(key, *kept);
+  }
+  if (events) *events = kept->events;
+  if (cost) *cost = kept->cost;
+  return kept->traces;
+}
+
+std::optional<std::vector<std::vector<double>>> Simulator::simulate(const ModelPoint& m, std::size_t samples,
+                                                                    std::vector<numeric::SimulationEvent>* events, long* cost) {
   std::optional<numeric::ValidatedEffectModel> model = family_.at(m.p, m.e);
   if (!model) {
     prepare({m});
@@ -40,7 +93,6 @@ std::optional<std::vector<std::vector<double>>> Simulator::traces(const ModelPoi
     if (!model) return std::nullopt;
   }
   numeric::SimulationOptions o;
-  samples = std::min(samples, data_.size());
   o.sample_times.assign(data_.t.begin(), data_.t.begin() + static_cast<std::ptrdiff_t>(samples));
   for (double& time : o.sample_times) time -= step_time_;  // the model's clock starts at the step
   o.t_end = std::min(t_end_ - step_time_, o.sample_times.back()) + 1e-9;
@@ -58,34 +110,43 @@ std::optional<std::vector<std::vector<double>>> Simulator::traces(const ModelPoi
   o.sample_sink = keep;
   ++simulations_;
   numeric::SimulationResult r;
+  const auto started = std::chrono::steady_clock::now();
   try {
     r = numeric::simulate_effects_step(*model, step_, o, {.general_engine = true});
   } catch (const std::exception& error) {  // a point the simulation cannot resolve: no trace there
     if (std::getenv("BACKLASH_DEBUG_FITS")) std::fprintf(stderr, "discrepancy: simulation failed (%s): %s\n", m.e.describe().c_str(), error.what());
     return std::nullopt;
   }
-  work_ += cost(m, r.events.size());
+  *cost = this->cost(m, r.events.size());
+  if (std::getenv("BACKLASH_DEBUG_COST"))  // calibrating the cost: work against the clock
+    std::fprintf(stderr, "cost %ld us %.0f events %zu samples %zu %s\n", *cost,
+                 1e6 * std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(), r.events.size(),
+                 samples, m.e.describe().c_str());
+  work_ += *cost;
   for (const numeric::TrajectorySample& s : r.samples) keep(s);  // a simulator that kept its samples
+  *events = r.events;
+  for (numeric::SimulationEvent& event : *events) event.t += step_time_;  // on the record's clock
   if (r.status == numeric::SimulationStatus::NonFinite || r.status == numeric::SimulationStatus::EventLimit ||
       r.status == numeric::SimulationStatus::Chattering || filled != samples)
     return std::nullopt;
-  if (events) {
-    *events = r.events;
-    for (numeric::SimulationEvent& event : *events) event.t += step_time_;  // on the record's clock
-  }
   return out;
 }
 
 long Simulator::cost(const ModelPoint& m, std::size_t events) const {
-  if (!(m.e.delay > 0)) return 1000 + static_cast<long>(events);
-  // A delayed model is integrated numerically: its steps follow the servo's oscillation and a
-  // compliant mesh's over the record.  Measured: a delayed case V (ω ≈ 1/s) over 30 s costs about
-  // 12 closed-form simulations (400 per radian of the servo), with a mesh of ω ≈ 26/s about 28
-  // (40 per radian of the mesh).
+  // Calibrated against the clock (BACKLASH_DEBUG_COST=1 prints both per simulation; about 0.1–0.3 µs
+  // per unit for every kind of model, docs/discrepancy.md "Work budget").  A closed-form model:
+  // 1000 plus its events.  A delayed model is integrated numerically: its steps follow the servo's
+  // oscillation over the record (a delayed case V over 30 s: about 12 closed-form simulations,
+  // 400 per radian) and a compliant mesh's, whose stiff oscillation then dominates (1300 per
+  // radian of the mesh: 0.1 s for a mesh of ω ≈ 26/s over 30 s), as with a saturating drive
+  // (50 per radian).  A compliant mesh alone is in closed form.
   const double span = t_end_ - step_time_;
-  double work = 1000 + static_cast<double>(events) + 400 * span * 2 * M_PI / numeric::servo_period(m.p);
-  if (m.e.compliant()) work += 40 * span * std::sqrt(m.e.mesh_stiffness * (m.p.Jm + m.p.JL) / (m.p.Jm * m.p.JL));
-  return static_cast<long>(work);
+  const double servo = span * 2 * M_PI / numeric::servo_period(m.p);
+  const double mesh = m.e.compliant() ? span * std::sqrt(m.e.mesh_stiffness * (m.p.Jm + m.p.JL) / (m.p.Jm * m.p.JL)) : 0.0;
+  double work = 1000 + static_cast<double>(events);
+  if (m.e.delay > 0) work += 400 * servo + 1300 * mesh;
+  else if (m.e.saturating()) work += 50 * mesh;
+  return static_cast<long>(std::min(work, 1e15));
 }
 
 std::vector<double> residuals(const Observations& data, const std::vector<std::vector<double>>& traces,
@@ -99,6 +160,15 @@ std::vector<double> residuals(const Observations& data, const std::vector<std::v
 
 double sum_of_squares(const std::vector<double>& r) {
   return std::inner_product(r.begin(), r.end(), r.begin(), 0.0);
+}
+
+double robust_sum(const std::vector<double>& r) {
+  // Huber's ρ(s) of s = r², as ceres::HuberLoss(kHuberScale) has it: s inside the scale, linear
+  // in |r| beyond (a residual of 20σ counts 111 instead of 400).
+  constexpr double c = kHuberScale;
+  double sum = 0;
+  for (double x : r) sum += std::fabs(x) <= c ? x * x : 2 * c * std::fabs(x) - c * c;
+  return sum;
 }
 
 // ------------------------------------------------------------------ the fit
@@ -134,10 +204,10 @@ struct Objective {
     if (work.load() >= budget || weighted.load() / 4 >= budget || simulator.budget_reached()) return std::nullopt;
     ++calls;
     std::vector<numeric::SimulationEvent> events;
-    const ModelPoint m = point(u);
-    const auto traces = simulator.traces(m, indices.back() + 1, &events);
+    long cost = 0;
+    const auto traces = simulator.traces(point(u), indices.back() + 1, &events, &cost);
     work += 1000 + static_cast<long>(events.size());
-    weighted += simulator.cost(m, events.size());
+    weighted += cost;
     if (!traces) return std::nullopt;
     return residuals(data, *traces, indices);
   }
@@ -168,7 +238,7 @@ Solved solve(const Objective& objective, std::vector<double> u, bool with_covari
   cost->AddParameterBlock(k);
   cost->SetNumResiduals(n);
   ceres::Problem problem;
-  problem.AddResidualBlock(cost, nullptr, u.data());
+  problem.AddResidualBlock(cost, new ceres::HuberLoss(kHuberScale), u.data());  // robust_sum()'s loss
   for (int i = 0; i < k; ++i) {
     problem.SetParameterLowerBound(u.data(), i, 0.0);
     problem.SetParameterUpperBound(u.data(), i, 1.0);
@@ -227,7 +297,7 @@ Solved brent(const Objective& objective, double start, double cell) {
   auto sse = [&](double x) {
     const double at[1] = {x};
     const auto r = objective.residuals_at(at);
-    return r ? sum_of_squares(*r) : INFINITY;
+    return r ? robust_sum(*r) : INFINITY;
   };
   const double lo = std::max(0.0, start - cell), hi = std::min(1.0, start + cell);
   constexpr int points = 11;
@@ -249,7 +319,7 @@ std::vector<std::vector<double>> scan_starts(const Objective& objective, const E
   std::vector<std::pair<double, std::vector<double>>> scored;
   for (const std::vector<double>& u : c.scan()) {
     const auto r = objective.residuals_at(u.data());
-    if (r) scored.push_back({sum_of_squares(*r), u});
+    if (r) scored.push_back({robust_sum(*r), u});
   }
   std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<std::vector<double>> starts;

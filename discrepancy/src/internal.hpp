@@ -9,7 +9,9 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -77,8 +79,10 @@ class Simulator {
   Simulator(const Observations& data, double step, double t_end, double step_time = 0);
   /// θ at the record's times for each observed column; nothing if the model is outside the
   /// validated family or the simulation did not end in a normal status.
+  /// `cost`, if given, receives the simulation's work (cost()).
   std::optional<std::vector<std::vector<double>>> traces(const ModelPoint& m, std::size_t samples,
-                                                         std::vector<numeric::SimulationEvent>* events = nullptr);
+                                                         std::vector<numeric::SimulationEvent>* events = nullptr,
+                                                         long* cost = nullptr);
   /// Validates the family at these model points (a candidate's range corners).
   void prepare(const std::vector<ModelPoint>& points);
   int simulations() const { return simulations_.load(); }
@@ -90,8 +94,23 @@ class Simulator {
   /// Past this much work the fits stop (their best points kept): the whole search's budget.
   void set_budget(long budget) { budget_ = budget; }
   bool budget_reached() const { return work_.load() >= budget_; }
+  int cache_hits() const { return hits_.load(); }
 
  private:
+  /// A simulation kept: the traces (empty: it failed), its events and its cost.
+  struct Kept {
+    std::optional<std::vector<std::vector<double>>> traces;
+    std::vector<numeric::SimulationEvent> events;
+    long cost = 0;
+  };
+  std::optional<Kept> recall(const std::string& key);
+  std::optional<std::vector<std::vector<double>>> simulate(const ModelPoint& m, std::size_t samples,
+                                                           std::vector<numeric::SimulationEvent>* events, long* cost);
+  void keep(const std::string& key, const Kept& kept);
+  std::mutex cache_mutex_;
+  std::map<std::string, std::shared_ptr<const Kept>> cache_;  ///< the last simulations, by model point and length
+  std::vector<std::string> cache_order_;                    ///< oldest first
+  std::atomic<int> hits_{0};
   const Observations& data_;
   double step_, t_end_, step_time_;
   numeric::ValidatedModelFamily family_;
@@ -104,6 +123,13 @@ class Simulator {
 std::vector<double> residuals(const Observations& data, const std::vector<std::vector<double>>& traces,
                               const std::vector<std::size_t>& indices);
 double sum_of_squares(const std::vector<double>& r);
+/// The scale of the robust loss, in units of the noise's σ (the residuals are weighted by 1/σ):
+/// a residual beyond it counts linearly, not squared (docs/discrepancy.md, "Outliers").
+inline constexpr double kHuberScale = 3;
+/// Σ ρ(r²) with Huber's ρ at kHuberScale (ceres::HuberLoss): what every fit of a step record
+/// minimises — an outlier the spike test does not catch pulls no fit far.  (The scores — BIC,
+/// held-out RMS, gaps — stay sums of squares: a systematic gap of 25σ is not an outlier.)
+double robust_sum(const std::vector<double>& r);
 
 /// A candidate fitted: its parameters, and its scores.
 struct Fit {
@@ -153,7 +179,9 @@ double quantum_of(const std::vector<double>& y);
 
 /// Isolated spikes of a residual: samples that the linear extrapolations from either side and
 /// the interpolation between their neighbours all miss by more than 6·√6 white σ (a kink — an
-/// impact — is met by one of the three; a spike by none).  Flags them in `skip`.
+/// impact — is met by one of the three; a spike by none), and two spikes side by side (their
+/// mean missed by 10 white σ by the same three predictions from outside the pair).  Flags them in
+/// `skip`.
 void flag_spikes(const std::vector<double>& r, double white_sigma, std::vector<char>& skip);
 
 }  // namespace backlash::discrepancy::detail

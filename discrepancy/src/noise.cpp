@@ -90,6 +90,19 @@ void flag_spikes(const std::vector<double>& r, double white_sigma, std::vector<c
     const double miss = std::min({std::fabs(r[i] - left), std::fabs(r[i] - right), std::fabs(r[i] - middle)});
     if (miss > threshold) skip[i] = 1;
   }
+  // Two spikes side by side (each one's neighbour is the other: the test above misses them):
+  // their mean, at i + ½, missed by more than 10 white σ by the lines from either side and by the
+  // interpolation across the two (σ of those predictions: 2.9σ, 2.9σ and 0.7σ, the mean's 0.7σ),
+  // each of the two off that interpolation by more than half of it, on the same side.
+  const double pair_threshold = 10 * white_sigma;
+  for (std::size_t i = 2; i + 3 < r.size(); ++i) {
+    if (skip[i - 1] || skip[i] || skip[i + 1] || skip[i + 2]) continue;
+    const double a = r[i - 2], b = r[i - 1], c = r[i + 2], d = r[i + 3], mean = 0.5 * (r[i] + r[i + 1]), across = 0.5 * (b + c);
+    const double miss = std::min({std::fabs(mean - (2.5 * b - 1.5 * a)), std::fabs(mean - (2.5 * c - 1.5 * d)), std::fabs(mean - across)});
+    const bool both = (r[i] - across) * (r[i + 1] - across) > 0 && std::fabs(r[i] - across) > 0.5 * pair_threshold &&
+                      std::fabs(r[i + 1] - across) > 0.5 * pair_threshold;
+    if (miss > pair_threshold && both) skip[i] = skip[i + 1] = 1;
+  }
 }
 
 }  // namespace backlash::discrepancy::detail

@@ -6,11 +6,14 @@
 
 #include "backlash/model/effect_table.hpp"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <set>
 #include <thread>
 
 namespace backlash::discrepancy::detail {
@@ -51,6 +54,15 @@ bool Search::rescore() {
 }
 
 namespace {
+
+/// The candidates fitted in a round after the first (the rest screened out by their scans).
+constexpr std::size_t kRoundFits = 6;
+/// The singles a pair is built on: the round's best five by BIC (a pair's first effect can rank
+/// fourth or fifth alone, behind parameters that absorb part of both).
+constexpr std::size_t kSingles = 5;
+/// The partners fitted with each of a round's best kSingles singles (screened at its fit: a partner
+/// that only a joint fit shows — its single fit biased by the missing partner — can rank low there).
+constexpr std::size_t kPartners = 8;
 
 // A named candidate's parameters as reported (the compliance's damping from its ratio).
 std::vector<Parameter> reported(const EffectCandidate& c, const std::vector<double>& values,
@@ -104,8 +116,13 @@ void judge(Trial& t, const Search& s, int current_k) {
   t.result.delta_bic = t.result.bic - s.scores.bic(current_k);
   // Decisive on both: the BIC, and the held-out samples — they must shrink, or, when the model
   // already meets them at the noise level, at least not get worse.
+  // Shrinking means to at most decisive_holdout of the current RMS, or by as much as the held-out
+  // samples' own likelihood ratio calls decisive (n_eff·ln(SSE ratio) < −decisive_bic: a large
+  // gap that a real effect closes only in part, while another remains).
   const double held = s.scores.rms_holdout();
+  const double n_held = std::max(1.0, static_cast<double>(sc.n_holdout) / s.o.tau_int);
   const bool confirmed = t.result.rms_holdout < options.decisive_holdout * held ||
+                         n_held * 2 * std::log(t.result.rms_holdout / held) < -options.decisive_bic ||
                          (held <= options.noise_level && t.result.rms_holdout <= 1.02 * held);
   // A parameter pinned at the edge of its range cannot be told from that limit: not decisive.
   t.result.at_range_edge = std::any_of(t.fit.u.begin(), t.fit.u.end(), [](double u) { return u < 1e-3 || u > 1 - 1e-3; });
@@ -136,24 +153,126 @@ void run_trial(Trial& t, Search& s, const std::string& name, double departure, c
   t.result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
 }
 
+// Runs job(i) for i < n on the options' threads (each index once; the results stay in index order).
+template <typename Job>
+void parallel_for(std::size_t n, int threads, Job job) {
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    for (std::size_t i = next++; i < n; i = next++) job(i);
+  };
+  std::vector<std::thread> pool;
+  for (int k = 1; k < std::max(1, threads); ++k) pool.emplace_back(work);
+  work();
+  for (std::thread& th : pool) th.join();
+}
+
+// The directions in which already-fitted parameters move the residual on the fitted samples: the
+// columns ∂r/∂u at `u` of `c` applied to `base` (central differences, ±0.01 in u), orthonormalised
+// (thin QR).  Empty when a point could not be simulated.
+Eigen::MatrixXd directions(Search& s, const EffectCandidate& c, const ModelPoint& base, const std::vector<double>& u) {
+  const std::size_t n = s.o.fit_indices.size() * s.o.columns.size();
+  Eigen::MatrixXd jacobian(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(u.size()));
+  for (std::size_t k = 0; k < u.size(); ++k) {
+    std::vector<double> plus = u, minus = u;
+    plus[k] = std::min(1.0, u[k] + 0.01), minus[k] = std::max(0.0, u[k] - 0.01);
+    std::vector<std::vector<double>> r;
+    for (const std::vector<double>* at : {&plus, &minus}) {
+      std::vector<double> values;
+      for (std::size_t i = 0; i < at->size(); ++i) values.push_back(c.ranges[i].value((*at)[i]));
+      const auto traces = s.simulator.traces(c.apply(base, values), s.o.size());
+      if (!traces) return {};
+      r.push_back(residuals(s.o, *traces, s.o.fit_indices));
+    }
+    for (std::size_t i = 0; i < n; ++i) jacobian(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(k)) = (r[0][i] - r[1][i]) / (plus[k] - minus[k]);
+  }
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(jacobian);
+  return qr.householderQ() * Eigen::MatrixXd::Identity(jacobian.rows(), jacobian.cols());
+}
+
+// Everything named as one candidate applied to the nominal model, and its coordinates now.
+std::pair<EffectCandidate, std::vector<double>> named_joint(const Search& s) {
+  std::vector<EffectCandidate> parts;
+  std::vector<double> u;
+  for (const Named& n : s.named) {
+    parts.push_back(n.candidate);
+    for (std::size_t j = 0; j < n.candidate.ranges.size(); ++j) u.push_back(coordinate_of(n.candidate, n.result.parameters, j, s.base));
+  }
+  return {combined(parts), u};
+}
+
+// The directions of everything named, and of `also` at `also_u` if given (none: empty).
+Eigen::MatrixXd named_directions(Search& s, const EffectCandidate* also = nullptr, const std::vector<double>* also_u = nullptr) {
+  auto [joint, u] = named_joint(s);
+  if (!also) return u.empty() ? Eigen::MatrixXd() : directions(s, joint, s.base, u);
+  std::vector<EffectCandidate> parts;
+  if (!u.empty()) parts.push_back(joint);
+  parts.push_back(*also);
+  u.insert(u.end(), also_u->begin(), also_u->end());
+  return directions(s, combined(parts), s.base, u);
+}
+
+// The best point of a candidate's scan added to `at`, on the fitted samples: its sum of squares
+// with the `fitted` directions projected out — what is left once the parameters already fitted
+// move with it, to first order (a partner that only shows when they move ranks where it belongs)
+// — INFINITY if no point could be simulated, and u.  At most a quarter of a single candidate's
+// budget (a stiff mesh with a delay is slow).
+double best_scan_point(Search& s, const EffectCandidate& c, const ModelPoint& at, const Eigen::MatrixXd& fitted,
+                       std::vector<double>& best_u) {
+  double best = INFINITY;
+  long work = 0;
+  for (const std::vector<double>& u : c.scan()) {
+    if (s.simulator.budget_reached() || work >= s.options.candidate_work / 4) break;
+    std::vector<double> values;
+    for (std::size_t k = 0; k < u.size(); ++k) values.push_back(c.ranges[k].value(u[k]));
+    long cost = 0;
+    const auto traces = s.simulator.traces(c.apply(at, values), s.o.size(), nullptr, &cost);
+    work += cost;
+    if (!traces) continue;
+    std::vector<double> r = residuals(s.o, *traces, s.o.fit_indices);
+    double sse = sum_of_squares(r);
+    if (fitted.cols() > 0 && static_cast<std::size_t>(fitted.rows()) == r.size())
+      sse -= (fitted.transpose() * Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()))).squaredNorm();
+    if (sse < best) best = sse, best_u = u;
+  }
+  return best;
+}
+
 // Every candidate of a round, fitted on the first part and scored (threads over candidates).
 std::vector<Trial> round_of(Search& s, double departure, const std::vector<std::string>& names) {
   std::vector<Trial> trials(names.size());
-  std::atomic<std::size_t> next{0};
+  // After the first round (the model then costs more: a delay named makes every simulation
+  // numerical), every candidate's scan is screened and only the best kRoundFits are fitted.
+  std::vector<char> fitted(names.size(), 1);
+  if (!s.named.empty() && names.size() > kRoundFits) {
+    std::vector<std::pair<double, std::size_t>> screened(names.size(), {INFINITY, 0});
+    const Eigen::MatrixXd named = named_directions(s);
+    parallel_for(names.size(), s.options.threads, [&](std::size_t i) {
+      screened[i].second = i;
+      try {
+        trials[i].candidate = candidate_for(names[i], s.current, s.step);
+        std::vector<double> u;
+        screened[i].first = best_scan_point(s, trials[i].candidate, s.current, named, u);
+      } catch (const std::exception&) {  // fitted (and failed) below, with its reason
+      }
+    });
+    std::stable_sort(screened.begin(), screened.end());
+    for (std::size_t k = kRoundFits; k < screened.size(); ++k) {
+      Trial& t = trials[screened[k].second];
+      fitted[screened[k].second] = 0;
+      t.result.effect = names[screened[k].second];
+      t.result.failure = "not fitted: its scan ranked " + std::to_string(k + 1) + " of " + std::to_string(names.size()) +
+                         " (the best " + std::to_string(kRoundFits) + " are fitted)";
+      t.result.bic = t.result.rms = t.result.rms_holdout = INFINITY;
+    }
+  }
   std::mutex progress_mutex;
   long finished = 0;
-  auto work = [&] {
-    for (std::size_t i = next++; i < trials.size(); i = next++) {
-      run_trial(trials[i], s, names[i], departure, nullptr);
-      if (!s.options.progress) continue;
-      std::lock_guard<std::mutex> lock(progress_mutex);
-      s.options.progress(++finished, static_cast<long>(trials.size()));
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int k = 1; k < std::max(1, s.options.threads); ++k) pool.emplace_back(work);
-  work();
-  for (std::thread& th : pool) th.join();
+  parallel_for(trials.size(), s.options.threads, [&](std::size_t i) {
+    if (fitted[i]) run_trial(trials[i], s, names[i], departure, nullptr);
+    if (!s.options.progress) return;
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    s.options.progress(++finished, static_cast<long>(trials.size()));
+  });
   std::stable_sort(trials.begin(), trials.end(), [](const Trial& a, const Trial& b) { return a.result.bic < b.result.bic; });
   return trials;
 }
@@ -214,30 +333,76 @@ std::string combination_problem(const std::string& a, const std::string& b) {
   return "";
 }
 
-// Every pair of the round's best four, fitted together
-// from their single fits and judged with both parameters' penalty.  The best decisive pair, or nothing.
+// A partner screened for a single candidate S: the best point of its scan with S at S's fit.
+struct Screened {
+  const Trial* single = nullptr;
+  const Trial* partner = nullptr;
+  std::vector<double> u;  ///< the partner's best scan point
+  double sse = INFINITY;
+  std::string problem;    ///< why the two cannot be combined
+};
+
+// The partner's scan, every point on the fitted samples with `single` at its fit.
+void screen(Screened& x, Search& s, const Eigen::MatrixXd& single) {
+  x.problem = combination_problem(x.single->result.effect, x.partner->result.effect);
+  if (x.problem.empty()) x.sse = best_scan_point(s, x.partner->candidate, x.single->point, single, x.u);
+}
+
+// "The best single plus one": each of the round's best kSingles singles S (fitted, by BIC) with
+// every other candidate screened at S's fit (a scan of the partner alone); the kPartners best partners
+// of each S fitted together with it (from S's fit and the partner's best scan point; a quarter
+// of a single candidate's budget) and judged with both parameters' penalty.  Two contact laws
+// cannot be combined: refused by name in the round's list.  The best decisive pair, or nothing.
 std::optional<Trial> best_pair(Search& s, const std::vector<Trial>& singles, double departure, std::vector<Candidate>& round) {
-  std::vector<const Trial*> top;
+  std::vector<const Trial*> fitted;
   for (const Trial& t : singles)
-    if (t.fit.ok && top.size() < 4) top.push_back(&t);
-  std::optional<Trial> best;
-  for (std::size_t i = 0; i < top.size(); ++i)
-    for (std::size_t j = i + 1; j < top.size(); ++j) {
-      Trial pair;
-      pair.candidate = combined({top[i]->candidate, top[j]->candidate});
-      if (const std::string problem = combination_problem(top[i]->result.effect, top[j]->result.effect); !problem.empty()) {
-        pair.result.effect = pair.candidate.effect;
-        pair.result.failure = problem;
-        pair.result.bic = pair.result.rms = pair.result.rms_holdout = INFINITY;
-        round.push_back(pair.result);
-        continue;
-      }
-      std::vector<double> start = top[i]->fit.u;
-      start.insert(start.end(), top[j]->fit.u.begin(), top[j]->fit.u.end());
-      run_trial(pair, s, pair.candidate.effect, departure, &start);
-      round.push_back(pair.result);
-      if (pair.result.decisive && (!best || pair.result.bic < best->result.bic)) best = std::move(pair);
+    if (t.fit.ok) fitted.push_back(&t);
+  std::vector<Screened> screened;
+  for (std::size_t i = 0; i < std::min(kSingles, fitted.size()); ++i)
+    for (const Trial* partner : fitted)
+      if (partner != fitted[i]) screened.push_back({fitted[i], partner, {}, INFINITY, ""});
+  std::vector<Eigen::MatrixXd> moving(std::min(kSingles, fitted.size()));  // each S's directions (with the named)
+  parallel_for(moving.size(), s.options.threads, [&](std::size_t i) {
+    moving[i] = named_directions(s, &fitted[i]->candidate, &fitted[i]->fit.u);
+  });
+  parallel_for(screened.size(), s.options.threads, [&](std::size_t i) {
+    const std::size_t which = static_cast<std::size_t>(std::find(fitted.begin(), fitted.end(), screened[i].single) - fitted.begin());
+    screen(screened[i], s, moving[which]);
+  });
+  std::vector<const Screened*> chosen;
+  std::set<std::string> seen;
+  for (std::size_t i = 0; i < std::min(kSingles, fitted.size()); ++i) {
+    std::vector<const Screened*> mine;
+    for (const Screened& x : screened)
+      if (x.single == fitted[i] && std::isfinite(x.sse)) mine.push_back(&x);
+    std::sort(mine.begin(), mine.end(), [](const Screened* a, const Screened* b) { return a->sse < b->sse; });
+    for (std::size_t k = 0; k < std::min<std::size_t>(kPartners, mine.size()); ++k) {
+      const std::string a = mine[k]->single->result.effect, b = mine[k]->partner->result.effect;
+      if (seen.insert(std::min(a, b) + " + " + std::max(a, b)).second) chosen.push_back(mine[k]);
     }
+  }
+  for (const Screened& x : screened)  // refused combinations, by name
+    if (!x.problem.empty() && seen.insert(std::min(x.single->result.effect, x.partner->result.effect) + " + " +
+                                          std::max(x.single->result.effect, x.partner->result.effect))
+                                  .second) {
+      Candidate refused;
+      refused.effect = x.single->result.effect + " + " + x.partner->result.effect;
+      refused.failure = x.problem;
+      refused.bic = refused.rms = refused.rms_holdout = INFINITY;
+      round.push_back(refused);
+    }
+  std::vector<Trial> pairs(chosen.size());
+  parallel_for(chosen.size(), s.options.threads, [&](std::size_t i) {
+    pairs[i].candidate = combined({chosen[i]->single->candidate, chosen[i]->partner->candidate});
+    std::vector<double> start = chosen[i]->single->fit.u;
+    start.insert(start.end(), chosen[i]->u.begin(), chosen[i]->u.end());
+    run_trial(pairs[i], s, pairs[i].candidate.effect, departure, &start);
+  });
+  std::optional<Trial> best;
+  for (Trial& pair : pairs) {
+    round.push_back(pair.result);
+    if (pair.result.decisive && (!best || pair.result.bic < best->result.bic)) best = std::move(pair);
+  }
   return best;
 }
 

@@ -6,6 +6,8 @@
 #include <charconv>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <mutex>
 #include <numeric>
 #include <stdexcept>
@@ -219,7 +221,7 @@ void read_noise(Observations& o, const std::vector<std::vector<double>>& nominal
   detail::reestimate_noise(o, nominal);
 }
 
-// The outliers listed: every flagged sample, its distance from its neighbours in σ.
+// The outliers listed: every flagged sample, its distance from its nearest unflagged neighbours in σ.
 std::vector<Outlier> outliers_of(const Observations& o, const std::vector<std::vector<double>>& model) {
   static const char* names[] = {"theta_out", "theta_motor", "theta_load"};
   std::vector<Outlier> out;
@@ -227,10 +229,13 @@ std::vector<Outlier> outliers_of(const Observations& o, const std::vector<std::v
     if (!o.skip[i]) continue;
     for (std::size_t c = 0; c < o.columns.size(); ++c) {
       const auto r = [&](std::size_t k) { return o.columns[c][k] - model[c][k]; };
-      const double size = (r(i) - 0.5 * (r(i - 1) + r(i + 1))) / o.sigma[c];
+      std::size_t before = i - 1, after = i + 1;  // the nearest samples not flagged (a spike's twin is)
+      while (before > 0 && o.skip[before]) --before;
+      while (after + 1 < o.size() && o.skip[after]) ++after;
+      const double size = (r(i) - 0.5 * (r(before) + r(after))) / o.sigma[c];
       if (c == 0 || std::fabs(size) > std::fabs(out.back().size)) {
         if (c > 0) out.pop_back();
-        out.push_back({o.t[i], names[o.which[c]], size});
+        out.push_back({i, o.t[i], names[o.which[c]], size});
       }
     }
   }
@@ -380,6 +385,10 @@ DiscrepancyResult find_discrepancy(const model::CaseSpec& spec, const measuremen
   result.distinguishing_experiment = s.experiment;
   result.status = status_of(s, result.gap_after <= result.noise_estimate.at_noise, nominal_at_noise);
   result.simulations = simulator.simulations();
+  result.work = simulator.work();
+  if (std::getenv("BACKLASH_DEBUG_FITS"))
+    std::fprintf(stderr, "discrepancy: %d simulations, %d of them kept ones, work %ld\n", simulator.simulations(),
+                 simulator.cache_hits(), simulator.work());
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }

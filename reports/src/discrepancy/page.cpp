@@ -57,7 +57,7 @@ nlohmann::json corrections_json(const std::vector<ParameterCorrection>& correcti
 
 nlohmann::json noise_json(const NoiseEstimate& n, const std::vector<Outlier>& outliers) {
   nlohmann::json spikes = nlohmann::json::array();
-  for (const Outlier& o : outliers) spikes.push_back({{"t", o.t}, {"column", o.column}, {"size", o.size}});
+  for (const Outlier& o : outliers) spikes.push_back({{"index", o.index}, {"t", o.t}, {"column", o.column}, {"size", o.size}});
   return {{"sigma", n.sigma},         {"white_sigma", n.white_sigma}, {"correlation", n.correlation},
           {"tau_int", n.tau_int},     {"n_eff", n.n_eff},             {"at_noise", n.at_noise},
           {"outliers", spikes}};
