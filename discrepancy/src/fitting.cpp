@@ -162,12 +162,20 @@ double sum_of_squares(const std::vector<double>& r) {
   return std::inner_product(r.begin(), r.end(), r.begin(), 0.0);
 }
 
+namespace {
+double huber_rho(double r) {
+  // ceres::HuberLoss's ρ(s) of s = r²: s inside the scale, 2c|r| − c² beyond (a residual of
+  // 20σ counts 111 instead of 400).
+  static const ceres::HuberLoss loss(kHuberScale);
+  double rho[3];
+  loss.Evaluate(r * r, rho);
+  return rho[0];
+}
+}  // namespace
+
 double robust_sum(const std::vector<double>& r) {
-  // Huber's ρ(s) of s = r², as ceres::HuberLoss(kHuberScale) has it: s inside the scale, linear
-  // in |r| beyond (a residual of 20σ counts 111 instead of 400).
-  constexpr double c = kHuberScale;
   double sum = 0;
-  for (double x : r) sum += std::fabs(x) <= c ? x * x : 2 * c * std::fabs(x) - c * c;
+  for (double x : r) sum += huber_rho(x);
   return sum;
 }
 
@@ -219,7 +227,10 @@ struct CostFunctor {
   bool operator()(double const* const* parameters, double* out) const {
     const auto r = objective->residuals_at(parameters[0]);
     if (!r) return false;
-    std::copy(r->begin(), r->end(), out);
+    // Each residual through Huber's ρ on its own (sgn r·√ρ(r²)): the sum of squares Ceres
+    // minimises is robust_sum().  (A loss function on the residual block would act on the
+    // block's whole squared norm, Σ r², and robustify nothing.)
+    std::transform(r->begin(), r->end(), out, [](double x) { return std::copysign(std::sqrt(huber_rho(x)), x); });
     return true;
   }
 };
@@ -238,7 +249,7 @@ Solved solve(const Objective& objective, std::vector<double> u, bool with_covari
   cost->AddParameterBlock(k);
   cost->SetNumResiduals(n);
   ceres::Problem problem;
-  problem.AddResidualBlock(cost, new ceres::HuberLoss(kHuberScale), u.data());  // robust_sum()'s loss
+  problem.AddResidualBlock(cost, nullptr, u.data());  // the residuals come robust (CostFunctor)
   for (int i = 0; i < k; ++i) {
     problem.SetParameterLowerBound(u.data(), i, 0.0);
     problem.SetParameterUpperBound(u.data(), i, 1.0);

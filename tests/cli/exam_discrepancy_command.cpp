@@ -227,7 +227,7 @@ TEST(DiscrepancyCommand, exam_TheReadmeExamplesRunAndSayWhatTheReadmeSays) {
   std::vector<std::string> commands;
   for (std::string line; std::getline(readme, line);)
     if (line.rfind("build/bin/backlash discrepancy", 0) == 0) commands.push_back(line);
-  ASSERT_EQ(commands.size(), 3u) << "the README has " << commands.size() << " discrepancy examples instead of 3";
+  ASSERT_EQ(commands.size(), 4u) << "the README has " << commands.size() << " discrepancy examples instead of 4";
   Folder folder;
   int k = 0;
   for (std::string command : commands) {
@@ -247,6 +247,10 @@ TEST(DiscrepancyCommand, exam_TheReadmeExamplesRunAndSayWhatTheReadmeSays) {
     EXPECT_NE(r.out.find("effect_found"), std::string::npos) << r.out;
     if (command.find("hidden_friction") != std::string::npos) {
       EXPECT_NE(r.out.find("coulomb_load    torque = 0.0200002"), std::string::npos) << r.out;
+    } else if (command.find("friction_and_delay") != std::string::npos) {  // a pair: the best single plus one
+      EXPECT_NE(r.out.find("delay           tau = 0.188432 ± 5.6e-05"), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find("coulomb_load    torque = 0.0309826 ± 1.5e-05"), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find("(81.51 and 1.04 noise sigmas)"), std::string::npos) << r.out;
     } else {
       EXPECT_NE(r.out.find("coulomb_motor   torque = 20.3941"), std::string::npos) << r.out;
       EXPECT_NE(r.out.find("torque_offset   torque = 3.25104"), std::string::npos) << r.out;

@@ -160,7 +160,7 @@ struct DiscrepancyOptions {
   /// delayed model, integrated numerically, counts 400 more per radian of the servo's oscillation
   /// over the record (about 12000 for a delayed case V over 30 s) and 1300 per radian of a
   /// compliant mesh's.
-  long total_work = 65'000'000;
+  long total_work = 80'000'000;
   /// The nominal parameters tried as corrections (default: all; [fit] fixed removes some).
   std::vector<std::string> parameters = parameter_candidates();
   double ambiguity_bic = 2;       ///< two explanations whose BIC differ by less are alike
