@@ -125,7 +125,7 @@ double rms_on(const std::vector<double>& r, const std::vector<std::size_t>& samp
 double tau_int_on(const std::vector<double>& r, const std::vector<std::size_t>& samples) {
   std::vector<double> inner;
   for (std::size_t k : samples) inner.push_back(r[k]);
-  return std::max(1.0, measurements::integrated_autocorrelation_time(inner).tau);
+  return tau_int_or_one(inner);
 }
 
 // The effects the summed equation can name, in the order tried.
@@ -251,8 +251,11 @@ bool solve_gap(const Signals& s, const std::vector<double>& xf, const std::vecto
 
 // Contact where it is certain: the load's inverse dynamics R is the mesh torque, 0 in flight, and
 // on face σ it is −σ·P with P > 0; so the samples whose |R| exceeds a tenth of its 95th percentile
-// are in contact on face −sgn R (those within the filter's length of a change are left out by
-// solve_gap).  b, x0 (and 1/kc) by least squares over them.
+// are in contact on face −sgn R, and stay so while R keeps its sign and |R| a fortieth of that
+// percentile (a hysteresis: a cruise whose viscous torque sits near the tenth would otherwise
+// flicker in and out of contact with the noise, and no stretch would be steady).  Those within
+// the filter's length of a change are left out by solve_gap.  b, x0 (and 1/kc) by least squares
+// over them.
 GapFit fit_gap(const Signals& s, const std::vector<double>& xf, const std::vector<double>& R, bool compliant) {
   std::vector<double> size;
   for (std::size_t k = s.begin; k < s.end; ++k) size.push_back(std::fabs(R[k]));
@@ -260,8 +263,11 @@ GapFit fit_gap(const Signals& s, const std::vector<double>& xf, const std::vecto
   const double threshold = 0.1 * size[95 * size.size() / 100];
   GapFit g;
   g.face.assign(s.size(), 0);
-  for (std::size_t k = s.begin; k < s.end; ++k)
-    if (std::fabs(R[k]) > threshold) g.face[k] = R[k] > 0 ? -1 : 1;
+  for (std::size_t k = s.begin; k < s.end; ++k) {
+    const signed char face = R[k] > 0 ? -1 : 1;
+    const bool held = k > s.begin && g.face[k - 1] == face && std::fabs(R[k]) > threshold / 4;
+    if (held || std::fabs(R[k]) > threshold) g.face[k] = face;
+  }
   if (!solve_gap(s, xf, R, compliant, g)) g.sse = INFINITY;
   g.contact_fraction = static_cast<double>(g.contact.size()) / static_cast<double>(std::max<std::size_t>(1, s.end - s.begin));
   return g;

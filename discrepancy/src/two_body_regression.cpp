@@ -128,6 +128,11 @@ LinearFit solve(const Signals& s, const LoadSide& l, const Theta& start, const F
   return out;
 }
 
+double tau_int_or_one(const std::vector<double>& r) {
+  if (r.size() < 2 || std::all_of(r.begin(), r.end(), [&](double x) { return x == r.front(); })) return 1;
+  return std::max(1.0, measurements::integrated_autocorrelation_time(r).tau);
+}
+
 namespace {
 
 struct FunctionCost {
@@ -167,7 +172,7 @@ std::vector<double> ceres_sigma(const std::function<void(const double*, double*)
   }
   std::vector<double> r(n);
   residual(x.data(), r.data());
-  const double tau = std::max(1.0, measurements::integrated_autocorrelation_time(r).tau);
+  const double tau = tau_int_or_one(r);
   const double variance = std::inner_product(r.begin(), r.end(), r.begin(), 0.0) / static_cast<double>(n - k);
   ceres::Covariance::Options covariance_options;
   covariance_options.algorithm_type = ceres::DENSE_SVD;

@@ -72,6 +72,11 @@ struct LinearFit {
 LinearFit solve(const Signals& s, const LoadSide& l, const Theta& start, const FreeSet& free,
                 const std::vector<std::size_t>& samples);
 
+/// max(1, τ_int) of r (measurements::integrated_autocorrelation_time); 1 when r has fewer than
+/// two samples or all its samples are equal (nothing correlated to count: a fit that is exact,
+/// e.g. the gap of a rigid drive read on whole encoder counts).
+double tau_int_or_one(const std::vector<double>& r);
+
 /// Levenberg–Marquardt polish of `x` on `residual` (n residuals) and one σ per parameter:
 /// Ceres's covariance (numeric central differences) scaled by the residual variance and τ_int.
 /// `lower`: each parameter's lower bound (−∞: none); `relative_step` of the differences.
