@@ -303,20 +303,25 @@ LoadSide observed_load(const Signals& s, double b, const Theta& m, double compli
   return load_side(s, std::move(qL), false);
 }
 
-// The samples compared with the motor encoder alone: the reversals stay in (the gap shows
-// there); only the motor's rests longer than the filter's length are left out, with that length
-// around them.
-std::vector<std::size_t> observer_samples(const Signals& s) {
+// The samples compared on a drive with a gap: the reversals stay in (the gap shows there, and
+// with both encoders the bodies move apart there, which alone tells the two Coulomb frictions
+// apart); only the rests longer than the filter's length are left out, with that length around
+// them — the motor's, and the load's when `vL` is given (a body at rest may stick).
+std::vector<std::size_t> observer_samples(const Signals& s, const std::vector<double>* vL = nullptr) {
   const std::size_t n = s.size();
   std::vector<char> in(n, 0);
   for (std::size_t i = s.begin; i < s.end; ++i) in[i] = 1;
-  for (std::size_t i = 0; i < n;) {
-    std::size_t j = i;
-    while (j < n && std::fabs(s.vm[j]) <= s.rest_speed) ++j;
-    if (j - i >= s.reach)
-      for (std::size_t k = i >= s.reach ? i - s.reach : 0; k < std::min(n, j + s.reach); ++k) in[k] = 0;
-    i = j + 1;
-  }
+  auto leave_out_rests = [&](const std::vector<double>& v) {
+    for (std::size_t i = 0; i < n;) {
+      std::size_t j = i;
+      while (j < n && std::fabs(v[j]) <= s.rest_speed) ++j;
+      if (j - i >= s.reach)
+        for (std::size_t k = i >= s.reach ? i - s.reach : 0; k < std::min(n, j + s.reach); ++k) in[k] = 0;
+      i = j + 1;
+    }
+  };
+  leave_out_rests(s.vm);
+  if (vL) leave_out_rests(*vL);
   std::vector<std::size_t> out;
   for (std::size_t i = 0; i < n; ++i)
     if (in[i]) out.push_back(i);
@@ -597,22 +602,59 @@ struct Fitted {
   std::vector<std::size_t> all;
 };
 
+// Both encoders: the two bodies move together wherever the summed equation is compared, so it
+// sees only the sum of their Coulomb frictions; the load's own is read on its coasting in flight
+// (flight_coulomb with α = FL/JL and the faces of the `summed` model, whose viscous friction is
+// right once the sum is named) and, when decisive, named first and held in `current` (the
+// summed equation's rounds are then run again, and name the motor's).
+FlightFit load_coulomb_in_flight(const Signals& s, const LoadSide& l, const std::vector<double>& xf, const DriveOptions& options,
+                                 const Theta& summed, Theta& current, DriveDiscrepancyResult& result) {
+  if (current[kTL] != 0) return {};
+  std::vector<double> R(s.size());
+  for (std::size_t k = 0; k < s.size(); ++k) R[k] = summed[kJL] * l.aL[k] + summed[kFL] * l.vL[k] + (summed[kTL] + summed[kTm]) * l.sL_f[k];
+  const GapFit g = fit_gap(s, xf, R, false);
+  if (!std::isfinite(g.sse) || !(g.b > 0)) return {};
+  const FlightFit flight = flight_coulomb(s, l, g.x0, g.b, summed[kFL] / summed[kJL]);
+  if (!flight.ok) return flight;
+  Candidate c;
+  c.effect = "coulomb_load";
+  c.parameters = {{"torque", flight.beta * current[kJL], flight.sigma * current[kJL]}};
+  c.delta_bic = flight.delta_bic;
+  c.at_range_edge = !(flight.beta > 0);
+  c.decisive = c.delta_bic < -options.decisive_bic && !c.at_range_edge;
+  if (!c.decisive) {
+    result.rounds.push_back({c});
+    return flight;
+  }
+  result.rounds = {{c}}, result.effects = {c};  // the summed equation's rounds again, with TL held
+  current[kTL] = flight.beta * summed[kJL];
+  return flight;
+}
+
 // Both encoders: the summed equation with the load measured; the gap read on its faces.
 void both_encoders(const Signals& s, const DriveOptions& options, Fitted& f, DriveDiscrepancyResult& result, TwoBodyFindings& two) {
   const LoadSide l = load_side(s, s.qL, true);
-  Search w{s, l, compared_samples(s, l, true), {}, {}, options};
+  Search w{s, l, observer_samples(s, &l.vL), {}, {}, options};
   split_blocks(s, w.all, w.fit, w.holdout);
   const LinearFit nominal = solve(s, l, f.given, f.free, w.all);
   if (!nominal.ok) throw std::invalid_argument(s.name + ": the record does not fit a physical drive with the load's parameters free (JL > 0, FL >= 0)");
   f.nominal = nominal.m;
-  f.m = name_effects(w, f.nominal, f.free, result);
-  f.sigma = summed_sigma(s, l, f.m, f.free, w.all);
-  f.r_given = residuals(s, l, f.given), f.r_nominal = residuals(s, l, f.nominal), f.r_after = residuals(s, l, f.m);
-  f.all = w.all;
-  // The gap on its faces, with the load's inverse dynamics R of the fitted model.
   std::vector<double> x(s.size()), R(s.size());
   for (std::size_t k = 0; k < s.size(); ++k) x[k] = s.qL[k] - s.qm[k];
   const std::vector<double> xf = measurements::zero_phase_filter(x, s.filter);
+  FreeSet free = f.free;
+  f.m = name_effects(w, f.nominal, free, result);
+  Theta current = f.nominal;
+  const FlightFit flight = load_coulomb_in_flight(s, l, xf, options, f.m, current, result);
+  if (current[kTL] != f.nominal[kTL]) f.m = name_effects(w, current, f.free, result);
+  else f.free = free;
+  f.sigma = summed_sigma(s, l, f.m, f.free, w.all);
+  if (flight.ok && current[kTL] != f.nominal[kTL]) {
+    f.m[kTL] = flight.beta * f.m[kJL], f.sigma[kTL] = flight.sigma * f.m[kJL];
+  }
+  f.r_given = residuals(s, l, f.given), f.r_nominal = residuals(s, l, f.nominal), f.r_after = residuals(s, l, f.m);
+  f.all = w.all;
+  // The gap on its faces, with the load's inverse dynamics R of the fitted model.
   for (std::size_t k = 0; k < s.size(); ++k) R[k] = f.m[kJL] * l.aL[k] + f.m[kFL] * l.vL[k] + f.m[kTL] * l.sL_f[k];
   GapFit rigid = fit_gap(s, xf, R, false);
   GapFit g = rigid;
