@@ -707,9 +707,15 @@ void motor_encoder(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   fit_shape(s, final_fit, f.free, coulomb_load, false, samples);
   f.sigma = observer_sigma(s, final_fit, f.free, coulomb_load, samples);
   f.m = final_fit.m, f.b = final_fit.z.b, f.sigma_b = final_fit.sigma_b;
+  // The load's parameters untied from the shape: least squares of the summed equation on the
+  // load the fitted shape observes (in contact the load's viscous friction is the total less the
+  // motor's; the shape's α = FL/JL only governs the brief flights).
+  const LoadSide observed = observed_load(s, f.b, f.m, f.compliance);
+  const LinearFit untied = solve(s, observed, f.m, f.free, samples);
+  if (untied.ok) f.m = untied.m;
   f.r_given = residuals(s, observed_load(s, f.given_b, f.given, f.compliance), f.given);
   f.r_nominal = residuals(s, l, f.nominal);
-  f.r_after = residuals(s, observed_load(s, f.b, f.m, f.compliance), f.m);
+  f.r_after = residuals(s, observed, f.m);
   f.all = samples;
   two.torque_rms_rigid = std::sqrt(final_fit.sse_rigid / static_cast<double>(std::max<std::size_t>(1, samples.size())));
   two.contact_fraction = NAN;
