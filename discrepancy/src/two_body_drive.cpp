@@ -213,10 +213,12 @@ Theta name_effects(const Search& w, Theta current, FreeSet& free, DriveDiscrepan
 
 namespace {
 
-// The gap's fit on the faces: x = x0 + σ·b/2 − c·R over the samples in contact (c = 1/kc, 0 for
-// a rigid mesh), R the load's inverse dynamics.
+// The gap's fit on the faces: x = x0 + σ·b/2 − c·R − d·ẋ over the samples in contact (c = 1/kc,
+// 0 for a rigid mesh; d = cm/kc the mesh's damping over its stiffness: the mesh torque
+// P = kc·δ + cm·δ̇ gives δ = P/kc − d·δ̇), R the load's inverse dynamics.
 struct GapFit {
-  double x0 = 0, b = 0, c = 0;
+  double x0 = 0, b = 0, c = 0, d = 0;
+  std::vector<double> xdot;  // ẋ of the filtered gap (compliant fits)
   double sigma_b = NAN, sigma_c = NAN;
   std::vector<std::size_t> contact;
   std::vector<signed char> face;  // at every sample: ±1 in contact, 0 in flight
@@ -231,19 +233,19 @@ bool solve_gap(const Signals& s, const std::vector<double>& xf, const std::vecto
     for (std::size_t j = k - s.reach; steady && j <= k + s.reach; ++j) steady = g.face[j] == g.face[k];
     if (steady) rows.push_back(k);
   }
-  const int cols = compliant ? 3 : 2;
+  const int cols = compliant ? 4 : 2;
   if (rows.size() < 10) return false;
   Eigen::MatrixXd A(rows.size(), cols);
   Eigen::VectorXd y(rows.size());
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const std::size_t k = rows[i];
     A(i, 0) = 1, A(i, 1) = 0.5 * g.face[k];
-    if (compliant) A(i, 2) = -R[k];
+    if (compliant) A(i, 2) = -R[k], A(i, 3) = -g.xdot[k];
     y(i) = xf[k];
   }
   const Eigen::VectorXd x = A.colPivHouseholderQr().solve(y);
   if (!x.allFinite()) return false;
-  g.x0 = x(0), g.b = x(1), g.c = compliant ? x(2) : 0;
+  g.x0 = x(0), g.b = x(1), g.c = compliant ? x(2) : 0, g.d = compliant ? x(3) : 0;
   g.contact = rows;
   g.sse = (A * x - y).squaredNorm();
   return true;
@@ -262,6 +264,7 @@ GapFit fit_gap(const Signals& s, const std::vector<double>& xf, const std::vecto
   std::nth_element(size.begin(), size.begin() + static_cast<std::ptrdiff_t>(95 * size.size() / 100), size.end());
   const double threshold = 0.1 * size[95 * size.size() / 100];
   GapFit g;
+  if (compliant) g.xdot = measurements::derivatives(xf, s.fs).velocity;
   g.face.assign(s.size(), 0);
   for (std::size_t k = s.begin; k < s.end; ++k) {
     const signed char face = R[k] > 0 ? -1 : 1;
@@ -275,18 +278,18 @@ GapFit fit_gap(const Signals& s, const std::vector<double>& xf, const std::vecto
 
 // The uncertainties of the gap's fit (Ceres's covariance of the same linear model).
 void gap_sigma(const std::vector<double>& xf, const std::vector<double>& R, GapFit& g) {
-  std::vector<double> x{g.x0, g.b, g.c};
-  const std::size_t k = g.c != 0 ? 3 : 2;
+  std::vector<double> x{g.x0, g.b, g.c, g.d};
+  const std::size_t k = g.c != 0 ? 4 : 2;
   x.resize(k);
   const std::function<void(const double*, double*)> f = [&](const double* p, double* r) {
     for (std::size_t i = 0; i < g.contact.size(); ++i) {
       const std::size_t j = g.contact[i];
-      r[i] = xf[j] - (p[0] + 0.5 * g.face[j] * p[1] - (k == 3 ? p[2] * R[j] : 0.0));
+      r[i] = xf[j] - (p[0] + 0.5 * g.face[j] * p[1] - (k == 4 ? p[2] * R[j] + p[3] * g.xdot[j] : 0.0));
     }
   };
   const std::vector<double> sigma = ceres_sigma(f, g.contact.size(), x, std::vector<double>(k, -INFINITY), false);
   g.sigma_b = sigma[1];
-  if (k == 3) g.sigma_c = sigma[2];
+  if (k == 4) g.sigma_c = sigma[2];
 }
 
 }  // namespace
@@ -664,7 +667,7 @@ void both_encoders(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   Candidate c;
   c.effect = "compliance";
   if (std::isfinite(compliant.sse) && compliant.contact.size() > 10) {
-    c.delta_bic = n_eff * std::log(std::max(compliant.sse, 1e-300) / std::max(rigid.sse, 1e-300)) + std::log(n_eff);
+    c.delta_bic = n_eff * std::log(std::max(compliant.sse, 1e-300) / std::max(rigid.sse, 1e-300)) + 2 * std::log(n_eff);  // 1/kc and cm/kc
     c.at_range_edge = !(compliant.c > 0);
     c.decisive = c.delta_bic < -options.decisive_bic && !c.at_range_edge;
     if (c.decisive) g = compliant;
