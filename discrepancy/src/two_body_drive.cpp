@@ -125,7 +125,7 @@ double rms_on(const std::vector<double>& r, const std::vector<std::size_t>& samp
 double tau_int_on(const std::vector<double>& r, const std::vector<std::size_t>& samples) {
   std::vector<double> inner;
   for (std::size_t k : samples) inner.push_back(r[k]);
-  return std::max(1.0, measurements::integrated_autocorrelation_time(inner).tau);
+  return tau_int_or_one(inner);
 }
 
 // The effects the summed equation can name, in the order tried.
@@ -213,10 +213,12 @@ Theta name_effects(const Search& w, Theta current, FreeSet& free, DriveDiscrepan
 
 namespace {
 
-// The gap's fit on the faces: x = x0 + σ·b/2 − c·R over the samples in contact (c = 1/kc, 0 for
-// a rigid mesh), R the load's inverse dynamics.
+// The gap's fit on the faces: x = x0 + σ·b/2 − c·R − d·ẋ over the samples in contact (c = 1/kc,
+// 0 for a rigid mesh; d = cm/kc the mesh's damping over its stiffness: the mesh torque
+// P = kc·δ + cm·δ̇ gives δ = P/kc − d·δ̇), R the load's inverse dynamics.
 struct GapFit {
-  double x0 = 0, b = 0, c = 0;
+  double x0 = 0, b = 0, c = 0, d = 0;
+  std::vector<double> xdot;  // ẋ of the filtered gap (compliant fits)
   double sigma_b = NAN, sigma_c = NAN;
   std::vector<std::size_t> contact;
   std::vector<signed char> face;  // at every sample: ±1 in contact, 0 in flight
@@ -231,19 +233,19 @@ bool solve_gap(const Signals& s, const std::vector<double>& xf, const std::vecto
     for (std::size_t j = k - s.reach; steady && j <= k + s.reach; ++j) steady = g.face[j] == g.face[k];
     if (steady) rows.push_back(k);
   }
-  const int cols = compliant ? 3 : 2;
+  const int cols = compliant ? 4 : 2;
   if (rows.size() < 10) return false;
   Eigen::MatrixXd A(rows.size(), cols);
   Eigen::VectorXd y(rows.size());
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const std::size_t k = rows[i];
     A(i, 0) = 1, A(i, 1) = 0.5 * g.face[k];
-    if (compliant) A(i, 2) = -R[k];
+    if (compliant) A(i, 2) = -R[k], A(i, 3) = -g.xdot[k];
     y(i) = xf[k];
   }
   const Eigen::VectorXd x = A.colPivHouseholderQr().solve(y);
   if (!x.allFinite()) return false;
-  g.x0 = x(0), g.b = x(1), g.c = compliant ? x(2) : 0;
+  g.x0 = x(0), g.b = x(1), g.c = compliant ? x(2) : 0, g.d = compliant ? x(3) : 0;
   g.contact = rows;
   g.sse = (A * x - y).squaredNorm();
   return true;
@@ -251,17 +253,24 @@ bool solve_gap(const Signals& s, const std::vector<double>& xf, const std::vecto
 
 // Contact where it is certain: the load's inverse dynamics R is the mesh torque, 0 in flight, and
 // on face σ it is −σ·P with P > 0; so the samples whose |R| exceeds a tenth of its 95th percentile
-// are in contact on face −sgn R (those within the filter's length of a change are left out by
-// solve_gap).  b, x0 (and 1/kc) by least squares over them.
+// are in contact on face −sgn R, and stay so while R keeps its sign and |R| a fortieth of that
+// percentile (a hysteresis: a cruise whose viscous torque sits near the tenth would otherwise
+// flicker in and out of contact with the noise, and no stretch would be steady).  Those within
+// the filter's length of a change are left out by solve_gap.  b, x0 (and 1/kc) by least squares
+// over them.
 GapFit fit_gap(const Signals& s, const std::vector<double>& xf, const std::vector<double>& R, bool compliant) {
   std::vector<double> size;
   for (std::size_t k = s.begin; k < s.end; ++k) size.push_back(std::fabs(R[k]));
   std::nth_element(size.begin(), size.begin() + static_cast<std::ptrdiff_t>(95 * size.size() / 100), size.end());
   const double threshold = 0.1 * size[95 * size.size() / 100];
   GapFit g;
+  if (compliant) g.xdot = measurements::derivatives(xf, s.fs).velocity;
   g.face.assign(s.size(), 0);
-  for (std::size_t k = s.begin; k < s.end; ++k)
-    if (std::fabs(R[k]) > threshold) g.face[k] = R[k] > 0 ? -1 : 1;
+  for (std::size_t k = s.begin; k < s.end; ++k) {
+    const signed char face = R[k] > 0 ? -1 : 1;
+    const bool held = k > s.begin && g.face[k - 1] == face && std::fabs(R[k]) > threshold / 4;
+    if (held || std::fabs(R[k]) > threshold) g.face[k] = face;
+  }
   if (!solve_gap(s, xf, R, compliant, g)) g.sse = INFINITY;
   g.contact_fraction = static_cast<double>(g.contact.size()) / static_cast<double>(std::max<std::size_t>(1, s.end - s.begin));
   return g;
@@ -269,18 +278,18 @@ GapFit fit_gap(const Signals& s, const std::vector<double>& xf, const std::vecto
 
 // The uncertainties of the gap's fit (Ceres's covariance of the same linear model).
 void gap_sigma(const std::vector<double>& xf, const std::vector<double>& R, GapFit& g) {
-  std::vector<double> x{g.x0, g.b, g.c};
-  const std::size_t k = g.c != 0 ? 3 : 2;
+  std::vector<double> x{g.x0, g.b, g.c, g.d};
+  const std::size_t k = g.c != 0 ? 4 : 2;
   x.resize(k);
   const std::function<void(const double*, double*)> f = [&](const double* p, double* r) {
     for (std::size_t i = 0; i < g.contact.size(); ++i) {
       const std::size_t j = g.contact[i];
-      r[i] = xf[j] - (p[0] + 0.5 * g.face[j] * p[1] - (k == 3 ? p[2] * R[j] : 0.0));
+      r[i] = xf[j] - (p[0] + 0.5 * g.face[j] * p[1] - (k == 4 ? p[2] * R[j] + p[3] * g.xdot[j] : 0.0));
     }
   };
   const std::vector<double> sigma = ceres_sigma(f, g.contact.size(), x, std::vector<double>(k, -INFINITY), false);
   g.sigma_b = sigma[1];
-  if (k == 3) g.sigma_c = sigma[2];
+  if (k == 4) g.sigma_c = sigma[2];
 }
 
 }  // namespace
@@ -297,20 +306,25 @@ LoadSide observed_load(const Signals& s, double b, const Theta& m, double compli
   return load_side(s, std::move(qL), false);
 }
 
-// The samples compared with the motor encoder alone: the reversals stay in (the gap shows
-// there); only the motor's rests longer than the filter's length are left out, with that length
-// around them.
-std::vector<std::size_t> observer_samples(const Signals& s) {
+// The samples compared on a drive with a gap: the reversals stay in (the gap shows there, and
+// with both encoders the bodies move apart there, which alone tells the two Coulomb frictions
+// apart); only the rests longer than the filter's length are left out, with that length around
+// them — the motor's, and the load's when `vL` is given (a body at rest may stick).
+std::vector<std::size_t> observer_samples(const Signals& s, const std::vector<double>* vL = nullptr) {
   const std::size_t n = s.size();
   std::vector<char> in(n, 0);
   for (std::size_t i = s.begin; i < s.end; ++i) in[i] = 1;
-  for (std::size_t i = 0; i < n;) {
-    std::size_t j = i;
-    while (j < n && std::fabs(s.vm[j]) <= s.rest_speed) ++j;
-    if (j - i >= s.reach)
-      for (std::size_t k = i >= s.reach ? i - s.reach : 0; k < std::min(n, j + s.reach); ++k) in[k] = 0;
-    i = j + 1;
-  }
+  auto leave_out_rests = [&](const std::vector<double>& v) {
+    for (std::size_t i = 0; i < n;) {
+      std::size_t j = i;
+      while (j < n && std::fabs(v[j]) <= s.rest_speed) ++j;
+      if (j - i >= s.reach)
+        for (std::size_t k = i >= s.reach ? i - s.reach : 0; k < std::min(n, j + s.reach); ++k) in[k] = 0;
+      i = j + 1;
+    }
+  };
+  leave_out_rests(s.vm);
+  if (vL) leave_out_rests(*vL);
   std::vector<std::size_t> out;
   for (std::size_t i = 0; i < n; ++i)
     if (in[i]) out.push_back(i);
@@ -591,22 +605,59 @@ struct Fitted {
   std::vector<std::size_t> all;
 };
 
+// Both encoders: the two bodies move together wherever the summed equation is compared, so it
+// sees only the sum of their Coulomb frictions; the load's own is read on its coasting in flight
+// (flight_coulomb with α = FL/JL and the faces of the `summed` model, whose viscous friction is
+// right once the sum is named) and, when decisive, named first and held in `current` (the
+// summed equation's rounds are then run again, and name the motor's).
+FlightFit load_coulomb_in_flight(const Signals& s, const LoadSide& l, const std::vector<double>& xf, const DriveOptions& options,
+                                 const Theta& summed, Theta& current, DriveDiscrepancyResult& result) {
+  if (current[kTL] != 0) return {};
+  std::vector<double> R(s.size());
+  for (std::size_t k = 0; k < s.size(); ++k) R[k] = summed[kJL] * l.aL[k] + summed[kFL] * l.vL[k] + (summed[kTL] + summed[kTm]) * l.sL_f[k];
+  const GapFit g = fit_gap(s, xf, R, false);
+  if (!std::isfinite(g.sse) || !(g.b > 0)) return {};
+  const FlightFit flight = flight_coulomb(s, l, g.x0, g.b, summed[kFL] / summed[kJL]);
+  if (!flight.ok) return flight;
+  Candidate c;
+  c.effect = "coulomb_load";
+  c.parameters = {{"torque", flight.beta * current[kJL], flight.sigma * current[kJL]}};
+  c.delta_bic = flight.delta_bic;
+  c.at_range_edge = !(flight.beta > 0);
+  c.decisive = c.delta_bic < -options.decisive_bic && !c.at_range_edge;
+  if (!c.decisive) {
+    result.rounds.push_back({c});
+    return flight;
+  }
+  result.rounds = {{c}}, result.effects = {c};  // the summed equation's rounds again, with TL held
+  current[kTL] = flight.beta * summed[kJL];
+  return flight;
+}
+
 // Both encoders: the summed equation with the load measured; the gap read on its faces.
 void both_encoders(const Signals& s, const DriveOptions& options, Fitted& f, DriveDiscrepancyResult& result, TwoBodyFindings& two) {
   const LoadSide l = load_side(s, s.qL, true);
-  Search w{s, l, compared_samples(s, l, true), {}, {}, options};
+  Search w{s, l, observer_samples(s, &l.vL), {}, {}, options};
   split_blocks(s, w.all, w.fit, w.holdout);
   const LinearFit nominal = solve(s, l, f.given, f.free, w.all);
   if (!nominal.ok) throw std::invalid_argument(s.name + ": the record does not fit a physical drive with the load's parameters free (JL > 0, FL >= 0)");
   f.nominal = nominal.m;
-  f.m = name_effects(w, f.nominal, f.free, result);
-  f.sigma = summed_sigma(s, l, f.m, f.free, w.all);
-  f.r_given = residuals(s, l, f.given), f.r_nominal = residuals(s, l, f.nominal), f.r_after = residuals(s, l, f.m);
-  f.all = w.all;
-  // The gap on its faces, with the load's inverse dynamics R of the fitted model.
   std::vector<double> x(s.size()), R(s.size());
   for (std::size_t k = 0; k < s.size(); ++k) x[k] = s.qL[k] - s.qm[k];
   const std::vector<double> xf = measurements::zero_phase_filter(x, s.filter);
+  FreeSet free = f.free;
+  f.m = name_effects(w, f.nominal, free, result);
+  Theta current = f.nominal;
+  const FlightFit flight = load_coulomb_in_flight(s, l, xf, options, f.m, current, result);
+  if (current[kTL] != f.nominal[kTL]) f.m = name_effects(w, current, f.free, result);
+  else f.free = free;
+  f.sigma = summed_sigma(s, l, f.m, f.free, w.all);
+  if (flight.ok && current[kTL] != f.nominal[kTL]) {
+    f.m[kTL] = flight.beta * f.m[kJL], f.sigma[kTL] = flight.sigma * f.m[kJL];
+  }
+  f.r_given = residuals(s, l, f.given), f.r_nominal = residuals(s, l, f.nominal), f.r_after = residuals(s, l, f.m);
+  f.all = w.all;
+  // The gap on its faces, with the load's inverse dynamics R of the fitted model.
   for (std::size_t k = 0; k < s.size(); ++k) R[k] = f.m[kJL] * l.aL[k] + f.m[kFL] * l.vL[k] + f.m[kTL] * l.sL_f[k];
   GapFit rigid = fit_gap(s, xf, R, false);
   GapFit g = rigid;
@@ -616,7 +667,7 @@ void both_encoders(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   Candidate c;
   c.effect = "compliance";
   if (std::isfinite(compliant.sse) && compliant.contact.size() > 10) {
-    c.delta_bic = n_eff * std::log(std::max(compliant.sse, 1e-300) / std::max(rigid.sse, 1e-300)) + std::log(n_eff);
+    c.delta_bic = n_eff * std::log(std::max(compliant.sse, 1e-300) / std::max(rigid.sse, 1e-300)) + 2 * std::log(n_eff);  // 1/kc and cm/kc
     c.at_range_edge = !(compliant.c > 0);
     c.decisive = c.delta_bic < -options.decisive_bic && !c.at_range_edge;
     if (c.decisive) g = compliant;
@@ -659,9 +710,15 @@ void motor_encoder(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   fit_shape(s, final_fit, f.free, coulomb_load, false, samples);
   f.sigma = observer_sigma(s, final_fit, f.free, coulomb_load, samples);
   f.m = final_fit.m, f.b = final_fit.z.b, f.sigma_b = final_fit.sigma_b;
+  // The load's parameters untied from the shape: least squares of the summed equation on the
+  // load the fitted shape observes (in contact the load's viscous friction is the total less the
+  // motor's; the shape's α = FL/JL only governs the brief flights).
+  const LoadSide observed = observed_load(s, f.b, f.m, f.compliance);
+  const LinearFit untied = solve(s, observed, f.m, f.free, samples);
+  if (untied.ok) f.m = untied.m;
   f.r_given = residuals(s, observed_load(s, f.given_b, f.given, f.compliance), f.given);
   f.r_nominal = residuals(s, l, f.nominal);
-  f.r_after = residuals(s, observed_load(s, f.b, f.m, f.compliance), f.m);
+  f.r_after = residuals(s, observed, f.m);
   f.all = samples;
   two.torque_rms_rigid = std::sqrt(final_fit.sse_rigid / static_cast<double>(std::max<std::size_t>(1, samples.size())));
   two.contact_fraction = NAN;

@@ -45,23 +45,6 @@ LoadSide load_side(const Signals& s, std::vector<double> qL, bool counted) {
   return l;
 }
 
-std::vector<std::size_t> compared_samples(const Signals& s, const LoadSide& l, bool both) {
-  const std::size_t n = s.size();
-  std::vector<char> in(n, 0);
-  for (std::size_t i = s.begin; i < s.end; ++i) in[i] = 1;
-  auto leave_out_changes = [&](const std::vector<signed char>& sign) {
-    for (std::size_t i = 0; i + 1 < n; ++i)
-      if (sign[i] != sign[i + 1])
-        for (std::size_t j = i >= s.reach ? i - s.reach : 0; j <= std::min(n - 1, i + 1 + s.reach); ++j) in[j] = 0;
-  };
-  leave_out_changes(s.sm);
-  if (both) leave_out_changes(l.sL);
-  std::vector<std::size_t> out;
-  for (std::size_t i = 0; i < n; ++i)
-    if (in[i]) out.push_back(i);
-  return out;
-}
-
 namespace {
 
 // The column of parameter i at sample k: r = Uf − Σ θ_i·c_i.
@@ -130,6 +113,67 @@ LinearFit solve(const Signals& s, const LoadSide& l, const Theta& start, const F
 
 namespace {
 
+// The runs of flight: consecutive samples inside the faces by the margin, the load moving one way.
+std::vector<std::pair<std::size_t, std::size_t>> flights_of(const Signals& s, const LoadSide& l, double x0, double b) {
+  double count = INFINITY;
+  for (std::size_t k = 1; k < s.size(); ++k)
+    if (l.qL[k] != l.qL[k - 1]) count = std::min(count, std::fabs(l.qL[k] - l.qL[k - 1]));
+  const double inside = b / 2 - 0.15 * b - 2 * (std::isfinite(count) ? count : 0);
+  std::vector<std::pair<std::size_t, std::size_t>> runs;
+  std::size_t start = s.begin;
+  for (std::size_t k = s.begin; k <= s.end; ++k) {
+    const bool in = k < s.end && inside > 0 && std::fabs(l.qL[k] - s.qm[k] - x0) < inside && l.sL[k] != 0;
+    if (in && k > start && l.sL[k] == l.sL[start]) continue;
+    if (k > start && k - start >= 8 && l.sL[start] != 0) runs.emplace_back(start, k);
+    start = in ? k : k + 1;
+  }
+  return runs;
+}
+
+}  // namespace
+
+FlightFit flight_coulomb(const Signals& s, const LoadSide& l, double x0, double b, double alpha) {
+  FlightFit out;
+  const auto runs = flights_of(s, l, x0, b);
+  std::size_t n = 0;
+  for (const auto& [a, e] : runs) n += e - a;
+  const std::size_t cols = 2 * runs.size() + 1;
+  if (n < 20 || n < cols + 5) return out;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(cols));
+  Eigen::VectorXd y(static_cast<Eigen::Index>(n));
+  Eigen::Index row = 0;
+  for (std::size_t r = 0; r < runs.size(); ++r)
+    for (std::size_t k = runs[r].first; k < runs[r].second; ++k, ++row) {
+      const double t = s.t[k] - s.t[runs[r].first], at = alpha * t;
+      const double phi1 = at < 1e-6 ? t : -std::expm1(-at) / alpha;
+      const double phi2 = at < 1e-6 ? t * t / 2 : t / alpha + std::expm1(-at) / (alpha * alpha);
+      A(row, static_cast<Eigen::Index>(2 * r)) = 1, A(row, static_cast<Eigen::Index>(2 * r + 1)) = phi1;
+      A(row, static_cast<Eigen::Index>(cols - 1)) = -l.sL[k] * phi2;
+      y(row) = l.qL[k];
+    }
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
+  const Eigen::VectorXd x = qr.solve(y);
+  const Eigen::VectorXd x0fit = A.leftCols(static_cast<Eigen::Index>(cols - 1)).colPivHouseholderQr().solve(y);
+  if (!x.allFinite() || !x0fit.allFinite()) return out;
+  const Eigen::VectorXd r = y - A * x;
+  const double sse = r.squaredNorm(), sse0 = (y - A.leftCols(static_cast<Eigen::Index>(cols - 1)) * x0fit).squaredNorm();
+  const double tau = tau_int_or_one(std::vector<double>(r.data(), r.data() + r.size()));
+  const double n_eff = static_cast<double>(n) / tau;
+  const Eigen::MatrixXd cov = (A.transpose() * A).inverse();
+  out.ok = true, out.samples = n, out.flights = runs.size();
+  out.beta = x(static_cast<Eigen::Index>(cols - 1));
+  out.sigma = std::sqrt(cov(static_cast<Eigen::Index>(cols - 1), static_cast<Eigen::Index>(cols - 1)) * sse / static_cast<double>(n - cols) * tau);
+  out.delta_bic = n_eff * std::log(std::max(sse, 1e-300) / std::max(sse0, 1e-300)) + std::log(n_eff);
+  return out;
+}
+
+double tau_int_or_one(const std::vector<double>& r) {
+  if (r.size() < 2 || std::all_of(r.begin(), r.end(), [&](double x) { return x == r.front(); })) return 1;
+  return std::max(1.0, measurements::integrated_autocorrelation_time(r).tau);
+}
+
+namespace {
+
 struct FunctionCost {
   const std::function<void(const double*, double*)>* f;
   bool operator()(double const* const* x, double* r) const {
@@ -167,7 +211,7 @@ std::vector<double> ceres_sigma(const std::function<void(const double*, double*)
   }
   std::vector<double> r(n);
   residual(x.data(), r.data());
-  const double tau = std::max(1.0, measurements::integrated_autocorrelation_time(r).tau);
+  const double tau = tau_int_or_one(r);
   const double variance = std::inner_product(r.begin(), r.end(), r.begin(), 0.0) / static_cast<double>(n - k);
   ceres::Covariance::Options covariance_options;
   covariance_options.algorithm_type = ceres::DENSE_SVD;

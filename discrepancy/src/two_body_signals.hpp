@@ -55,10 +55,6 @@ std::vector<signed char> signs_of(const std::vector<double>& q, const std::vecto
 /// The load side from its position (filtered and differentiated as the motor's).
 LoadSide load_side(const Signals& s, std::vector<double> qL, bool counted);
 
-/// The samples compared: inside [begin, end), and not within `reach` of a change of the sign of
-/// the motor's motion (or of the load's, `both`) — rest included.
-std::vector<std::size_t> compared_samples(const Signals& s, const LoadSide& l, bool both);
-
 /// The residual at every sample.
 std::vector<double> residuals(const Signals& s, const LoadSide& l, const Theta& m);
 
@@ -71,6 +67,23 @@ struct LinearFit {
 };
 LinearFit solve(const Signals& s, const LoadSide& l, const Theta& start, const FreeSet& free,
                 const std::vector<std::size_t>& samples);
+
+/// The load's Coulomb friction per unit inertia β = TL/JL read on its coasting in flight (both
+/// encoders): where the raw gap θL − θm lies inside the faces x0 ± b/2 by a margin (15 % of b
+/// and two encoder counts) and the load moves one way, the load encoder follows
+///   θL(t) = p + v0·(1 − e^{−αt})/α − β·sL·(t/α − (1 − e^{−αt})/α²),   α = FL/JL given,
+/// linear in each flight's p, v0 and the shared β.  ΔBIC of β against β = 0 with n_eff = n/τ_int.
+struct FlightFit {
+  bool ok = false;           ///< enough flights (at least 20 samples in runs of 8 or more)
+  double beta = 0, sigma = NAN, delta_bic = INFINITY;
+  std::size_t samples = 0, flights = 0;
+};
+FlightFit flight_coulomb(const Signals& s, const LoadSide& l, double x0, double b, double alpha);
+
+/// max(1, τ_int) of r (measurements::integrated_autocorrelation_time); 1 when r has fewer than
+/// two samples or all its samples are equal (nothing correlated to count: a fit that is exact,
+/// e.g. the gap of a rigid drive read on whole encoder counts).
+double tau_int_or_one(const std::vector<double>& r);
 
 /// Levenberg–Marquardt polish of `x` on `residual` (n residuals) and one σ per parameter:
 /// Ceres's covariance (numeric central differences) scaled by the residual variance and τ_int.
