@@ -730,13 +730,17 @@ void motor_encoder(const Signals& s, const DriveOptions& options, Fitted& f, Dri
 
 namespace {
 
-// The status (as the rigid workflow's): effects named; else a nominal parameter corrected beyond
-// three σ (and 5 %); else the residual at the noise, or unexplained.
+// The status (docs/discrepancy.md, "Statuses"): effects named or a nominal parameter corrected
+// beyond three σ (and 5 %) — effect_found / parameters_corrected when the corrected model's
+// torque residual is at the noise, partly_explained when it stays above; else the residual at
+// the noise, or unexplained.
 Status status_of(const DriveDiscrepancyResult& r, const TwoBodyFindings& two) {
-  if (!r.effects.empty()) return Status::EffectFound;
+  const bool closed = r.rms_after <= kNoiseFactor * r.noise;
+  if (!r.effects.empty()) return closed ? Status::EffectFound : Status::PartlyExplained;
   for (const ParameterCorrection& c : two.parameter_corrections) {
     const double change = std::fabs(c.fitted - c.nominal);
-    if (change > 3 * c.uncertainty && change > 0.05 * std::fabs(c.nominal)) return Status::ParametersCorrected;
+    if (change > 3 * c.uncertainty && change > 0.05 * std::fabs(c.nominal))
+      return closed ? Status::ParametersCorrected : Status::PartlyExplained;
   }
   return r.rms_before <= kNoiseFactor * r.noise ? Status::NoDiscrepancy : Status::Unexplained;
 }
