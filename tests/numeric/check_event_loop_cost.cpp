@@ -13,6 +13,7 @@
 #include "backlash/numeric/evaluator.hpp"
 #include "backlash/numeric/hybrid_simulation.hpp"
 #include "backlash/numeric/validation.hpp"
+#include "counting_evaluator.hpp"
 
 #include <gtest/gtest.h>
 
@@ -47,28 +48,7 @@ namespace {
 
 using namespace backlash;
 
-// A generated case evaluator that counts its closed-form evaluations.
-class CountingEvaluator final : public numeric::SegmentEvaluator {
- public:
-  explicit CountingEvaluator(numeric::EvaluatorPtr inner) : inner_(std::move(inner)) {}
-  std::string name() const override { return inner_->name(); }
-  std::string kind() const override { return inner_->kind(); }
-  const numeric::Parameters& parameters() const override { return inner_->parameters(); }
-  numeric::BranchSelection branches() const override { return inner_->branches(); }
-  double cot_phi() const override { return inner_->cot_phi(); }
-  numeric::FreeState free_state(double t, double v0) const override {
-    ++evaluations;
-    return inner_->free_state(t, v0);
-  }
-  numeric::ContactState contact_state(double t, double x0, double v0) const override {
-    ++evaluations;
-    return inner_->contact_state(t, x0, v0);
-  }
-  mutable long evaluations = 0;
-
- private:
-  numeric::EvaluatorPtr inner_;
-};
+using backlash::testing::CountingEvaluator;
 
 struct Counted {
   std::shared_ptr<const CountingEvaluator> counter;

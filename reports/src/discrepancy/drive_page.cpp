@@ -145,7 +145,7 @@ std::string drive_to_json(const model::CaseSpec& model, const DriveDiscrepancyRe
       {"validation", r.validation ? scores_json(*r.validation) : nlohmann::json(nullptr)},
       {"least_squares", r.least_squares}};
   if (r.two_body) {  // a drive with a gap (two_body_drive.hpp)
-    out["parameter_corrections"] = detail::two_body_corrections_json(*r.two_body);
+    out["parameter_corrections"] = detail::corrections_json(r.two_body->parameter_corrections);
     out["two_body"] = detail::two_body_json(*r.two_body);
   }
   return out.dump(2) + "\n";
@@ -184,24 +184,36 @@ std::string drive_corrected_case_file(const model::CaseSpec& spec, const DriveDi
 
 namespace {
 
-// A drive with a gap: torque over the first three seconds, the lost motion, the hysteresis loop,
-// the first round's candidates.
-std::optional<std::string> two_body_drive_figures(const DriveDiscrepancyResult& r, std::vector<reports::Plot>& figures,
-                                                  std::vector<std::pair<std::string, std::string>>& files) {
-  const bool found = !r.effects.empty();
-  const std::pair<std::size_t, std::size_t> range{0, static_cast<std::size_t>(std::lower_bound(r.t.begin(), r.t.end(), r.t.front() + 3) - r.t.begin())};
+// Drive torque over the samples `range`: measured, and what each model needs; returns the
+// stretch's times (the position figure beside it shares them).
+std::vector<double> torque_over_time(const DriveDiscrepancyResult& r, std::pair<std::size_t, std::size_t> range,
+                                     const std::string& axis, std::vector<reports::Plot>& figures) {
   const std::vector<double> t = slice(r.t, range), measured = slice(r.torque_measured, range),
                             nominal = slice(r.torque_nominal, range), corrected = slice(r.torque_corrected, range);
   std::vector<Curve> torque{{"measured (filtered)", "#222", &t, &measured}, {"nominal needs", "#c33", &t, &nominal, true}};
-  if (found) torque.push_back({"corrected needs", "#2a7", &t, &corrected});
+  if (!r.effects.empty()) torque.push_back({"corrected needs", "#2a7", &t, &corrected});
   figures.push_back(line_plot("torque_over_time", "Drive torque: measured, and what each model needs along the measured motion",
-                              "t [s]", "drive torque [N·m]", torque));
-  detail::two_body_figures(*r.two_body, figures);
+                              "t [s]", axis, torque));
+  return t;
+}
+
+// The first round's candidates: torque RMS with each fitted.
+void candidates_chart(const DriveDiscrepancyResult& r, std::vector<reports::Plot>& figures) {
   std::vector<std::pair<std::string, double>> bars;
   if (!r.rounds.empty())
     for (const Candidate& c : r.rounds.front()) bars.push_back({c.effect, c.rms});
   figures.push_back(bar_chart("candidates", "First round: torque RMS with each candidate effect fitted", bars, r.rms_before,
                               "best nominal " + number(r.rms_before)));
+}
+
+// A drive with a gap: torque over the first three seconds, the lost motion, the hysteresis loop,
+// the first round's candidates.
+std::optional<std::string> two_body_drive_figures(const DriveDiscrepancyResult& r, std::vector<reports::Plot>& figures,
+                                                  std::vector<std::pair<std::string, std::string>>& files) {
+  const std::pair<std::size_t, std::size_t> range{0, static_cast<std::size_t>(std::lower_bound(r.t.begin(), r.t.end(), r.t.front() + 3) - r.t.begin())};
+  torque_over_time(r, range, "drive torque [N·m]", figures);
+  detail::two_body_figures(*r.two_body, figures);
+  candidates_chart(r, figures);
   return add_figures(figures, files);
 }
 
@@ -232,13 +244,7 @@ std::optional<std::string> drive_figures(const DriveDiscrepancyResult& r, std::v
   // (a drive with a gap: its own figures instead of the windows).
   if (r.two_body) return two_body_drive_figures(r, figures, files);
   const auto range = worst_windows(r.t, r.position, r.position_nominal, r.window_starts, 3);
-  const std::vector<double> t = slice(r.t, range), measured = slice(r.torque_measured, range),
-                            nominal = slice(r.torque_nominal, range), corrected = slice(r.torque_corrected, range);
-  std::vector<Curve> torque{{"measured (filtered)", "#222", &t, &measured},
-                             {"nominal needs", "#c33", &t, &nominal, true}};
-  if (found) torque.push_back({"corrected needs", "#2a7", &t, &corrected});
-  figures.push_back(line_plot("torque_over_time", "Drive torque: measured, and what each model needs along the measured motion",
-                              "t [s]", "drive force [N]", torque));
+  const std::vector<double> t = torque_over_time(r, range, "drive force [N]", figures);
   const std::vector<double> q = slice(r.position, range), qn = slice(r.position_nominal, range),
                             qc = slice(r.position_corrected, range);
   std::vector<Curve> position{{"measured", "#222", &t, &q}, {"nominal", "#c33", &t, &qn, true}};
@@ -258,11 +264,7 @@ std::optional<std::string> drive_figures(const DriveDiscrepancyResult& r, std::v
     figures.push_back(line_plot("validation_position_window", "Validation record (not fitted): position predicted over windows",
                                 "t [s]", "position [m]", vp));
   }
-  std::vector<std::pair<std::string, double>> bars;
-  if (!r.rounds.empty())
-    for (const Candidate& c : r.rounds.front()) bars.push_back({c.effect, c.rms});
-  figures.push_back(bar_chart("candidates", "First round: torque RMS with each candidate effect fitted", bars, r.rms_before,
-                              "best nominal " + number(r.rms_before)));
+  candidates_chart(r, figures);
   return add_figures(figures, files);
 }
 

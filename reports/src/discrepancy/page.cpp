@@ -43,18 +43,6 @@ nlohmann::json events_json(const std::vector<numeric::SimulationEvent>& events) 
   return out;
 }
 
-nlohmann::json corrections_json(const std::vector<ParameterCorrection>& corrections) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const ParameterCorrection& c : corrections)
-    out.push_back({{"key", c.key},
-                   {"nominal", c.nominal},
-                   {"fitted", c.fitted},
-                   {"sigma", json_number(c.uncertainty)},
-                   {"ratio", json_number(c.ratio)},
-                   {"given_free", c.given_free}});
-  return out;
-}
-
 nlohmann::json noise_json(const NoiseEstimate& n, const std::vector<Outlier>& outliers) {
   nlohmann::json spikes = nlohmann::json::array();
   for (const Outlier& o : outliers) spikes.push_back({{"index", o.index}, {"t", o.t}, {"column", o.column}, {"size", o.size}});
@@ -141,7 +129,7 @@ std::string to_json(const model::CaseSpec& model, const DiscrepancyResult& r, do
                        {"corrected", features_json(r.corrected)}}},
                      {"events", {{"nominal", events_json(r.nominal_events)}, {"corrected", events_json(r.corrected_events)}}},
                      {"simulations", r.simulations},
-                     {"parameter_corrections", corrections_json(r.parameter_corrections)},
+                     {"parameter_corrections", detail::corrections_json(r.parameter_corrections)},
                      {"noise_model", noise_json(r.noise_estimate, r.outliers)},
                      {"alternatives", effects_json(r.alternatives)},
                      {"distinguishing_experiment",

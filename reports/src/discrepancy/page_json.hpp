@@ -33,6 +33,19 @@ inline nlohmann::json parameter_sigmas_json(const std::vector<Parameter>& ps) {
 
 /// One candidate's fit; `work_key` names its count of simulations ("simulations" on a
 /// step record, "least_squares" on a measured drive).
+/// "parameter_corrections": key, nominal, fitted, sigma, ratio, given_free (both pages).
+inline nlohmann::json corrections_json(const std::vector<ParameterCorrection>& corrections) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const ParameterCorrection& c : corrections)
+    out.push_back({{"key", c.key},
+                   {"nominal", c.nominal},
+                   {"fitted", c.fitted},
+                   {"sigma", json_number(c.uncertainty)},
+                   {"ratio", json_number(c.ratio)},
+                   {"given_free", c.given_free}});
+  return out;
+}
+
 inline nlohmann::json candidate_json(const Candidate& c, const char* work_key) {
   return {{"effect", c.effect},
           {"parameters", parameter_values_json(c.parameters)},

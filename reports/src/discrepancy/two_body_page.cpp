@@ -9,18 +9,6 @@
 
 namespace backlash::discrepancy::detail {
 
-nlohmann::json two_body_corrections_json(const TwoBodyFindings& two) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const ParameterCorrection& c : two.parameter_corrections)
-    out.push_back({{"key", c.key},
-                   {"nominal", c.nominal},
-                   {"fitted", c.fitted},
-                   {"sigma", json_number(c.uncertainty)},
-                   {"ratio", json_number(c.ratio)},
-                   {"given_free", c.given_free}});
-  return out;
-}
-
 nlohmann::json two_body_json(const TwoBodyFindings& two) {
   nlohmann::json reversals = nlohmann::json::array();
   for (const LostMotion& l : two.reversals)

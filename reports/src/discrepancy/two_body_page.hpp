@@ -12,9 +12,6 @@
 
 namespace backlash::discrepancy::detail {
 
-/// "parameter_corrections": key, nominal, fitted, sigma, ratio, given_free (the backlash first).
-nlohmann::json two_body_corrections_json(const TwoBodyFindings& two);
-
 /// "two_body": the method, the encoders, rigid, the gap's offset, the lost motion at each reversal.
 nlohmann::json two_body_json(const TwoBodyFindings& two);
 
