@@ -2,6 +2,8 @@
 #include "backlash/numeric/settle.hpp"
 
 #include <cmath>
+#include <functional>
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -52,15 +54,17 @@ long long last_sample(const SettleOptions& o) {
 // The band (settle.hpp) and the first sample time after which every sample stays in it.  A run
 // with samples left out (SimulationOptions::sample_band) recorded the last one outside the band and
 // every one near its edges: the others lie inside, or before a later one outside.
+// `certified`: the run was stopped once every later θo was certified inside the moving band
+// (CycleCertificate): the sample at t_end is inside, and every sample the run did not reach.
 Settle judge(const SimulationResult& run, const std::vector<Sample>& theta_o, const Parameters& p,
-             const LimitCycle& cycle, const SettleOptions& o) {
+             const LimitCycle& cycle, const SettleOptions& o, bool certified = false) {
   Settle s;
-  if (stopped_early(run.status)) {
+  if (!certified && stopped_early(run.status)) {
     s.status = to_string(run.status);
     return s;
   }
   const double tol = o.fraction * std::fabs(o.step);
-  const SimulationOptions::SampleBand band = run.status == SimulationStatus::Rest
+  const SimulationOptions::SampleBand band = !certified && run.status == SimulationStatus::Rest
                                                  ? SimulationOptions::SampleBand{run.theta_o_final - tol, run.theta_o_final + tol}
                                                  : moving_band(p, cycle, tol);
   s.band_low = band.low, s.band_high = band.high;
@@ -71,7 +75,7 @@ Settle judge(const SimulationResult& run, const std::vector<Sample>& theta_o, co
   const bool thinned = run.samples_left_out > 0;
   const bool last_outside = thinned ? n > 0 && n == theta_o.size() && theta_o.back().k == last_sample(o)
                                     : theta_o.empty() || n == theta_o.size();
-  if (run.status != SimulationStatus::Rest && last_outside) {
+  if (!certified && run.status != SimulationStatus::Rest && last_outside) {
     s.status = "not_settled";
     return s;
   }
@@ -80,12 +84,95 @@ Settle judge(const SimulationResult& run, const std::vector<Sample>& theta_o, co
   return s;
 }
 
+// The certificate that a nominal step response has reached its stable symmetric cycle for good
+// (settle.hpp, "Certified on the cycle"): at a separation with speed u, the interval
+// I = [v* − r, v* + r], r = |u − v*|, mapped into itself by the half-cycle map g and with its ends'
+// half cycles inside the band by the sample band's margin (hybrid_simulation.hpp); by the odd
+// symmetry g(−v) = −g(v) one sign of the speed checks both faces.
+class CycleCertificate {
+ public:
+  /// A stable period-1 cycle without bounces: the one the half-cycle map describes.
+  static bool applies(const LimitCycle& c) {
+    return c.status == CycleStatus::LimitCycle && c.stable && c.period_count == 1 && !c.bounced &&
+           c.separation_velocity > 0 && std::fabs(c.half_map_derivative) < 1;
+  }
+  CycleCertificate(const ValidatedEvaluator& evaluator, const LimitCycle& cycle, SimulationOptions::SampleBand band)
+      : evaluator_(evaluator), cycle_(cycle), band_(band) {
+    const double R = evaluator.parameters().theta_R;
+    margin_ = 4 * evaluator.report().tolerance * std::max({1.0, std::fabs(band.low), std::fabs(band.high)});
+    // The first try: where the cycle's swing, grown in proportion to the speed, still fits the band.
+    const double swing = std::max(cycle.theta_o_max - R, R - cycle.theta_o_min);
+    const double room = std::min(band.high - R, R - band.low) - swing;
+    next_try_ = swing > 0 && room > 0 ? 0.9 * cycle.separation_velocity * room / swing : 0;
+  }
+  /// At a separation of the run: true when the motion from it is certified inside the band.
+  bool holds_after(const SimulationEvent& e) {
+    if (e.kind != EventKind::Separation || e.dtheta_o == 0) return false;
+    const double v = cycle_.separation_velocity, u = std::fabs(e.dtheta_o), d = std::fabs(u - v);
+    if (d > next_try_ || e.after.face != (e.dtheta_o > 0 ? -1 : +1)) return false;
+    next_try_ = d / 2;  // a failed try waits for the motion to come twice as close
+    // r: |u − v*| and a few ulps more, so that I holds u whatever the rounding of v* ± r.
+    return holds(e.dtheta_o > 0 ? 1.0 : -1.0, d * (1 + 1e-9) + 8 * std::numeric_limits<double>::epsilon() * v);
+  }
+
+ private:
+  bool holds(double sign, double r) const {
+    const double v = cycle_.separation_velocity;
+    const HalfCycle low = half_cycle(evaluator_, sign * (v - r), true), high = half_cycle(evaluator_, sign * (v + r), true);
+    if (!plain(low) || !plain(high) || low.events.size() != high.events.size()) return false;
+    const double g_low = sign * low.v_out, g_high = sign * high.v_out;
+    if (std::fabs(g_low - v) > r || std::fabs(g_high - v) > r) return false;
+    if ((g_high - g_low) * cycle_.half_map_derivative < 0) return false;
+    return inside(low.extremes) && inside(high.extremes);
+  }
+  // One recombination that holds, then the separation.
+  static bool plain(const HalfCycle& h) {
+    if (!h.valid || h.bounced || h.events.size() != 2) return false;
+    for (const SimulationEvent& e : h.events)
+      if (e.grazing || e.bounce) return false;
+    return h.events[0].kind == EventKind::Recombination && h.events[1].kind == EventKind::Separation;
+  }
+  // θo's extremes and their mirror images about θR inside the band by the margin.
+  bool inside(const Extremes& x) const {
+    const double R = evaluator_.parameters().theta_R;
+    const double high = std::max(x.theta_o_max, 2 * R - x.theta_o_min), low = std::min(x.theta_o_min, 2 * R - x.theta_o_max);
+    return std::isfinite(high) && std::isfinite(low) && high <= band_.high - margin_ && low >= band_.low + margin_;
+  }
+  const ValidatedEvaluator& evaluator_;
+  const LimitCycle& cycle_;
+  const SimulationOptions::SampleBand band_;
+  double margin_ = 0;
+  double next_try_ = 0;  // |u − v*| at which the next try is made
+};
+
+// Thrown from the run's event sink once every later θo is certified inside the moving band:
+// the run ends there (its samples so far are those of the whole run up to that time).
+struct InsideFromHere {};
+
 // The settle time from `simulate(options)`: with samples left out by the moving band, again with
-// all of them when that run stopped at rest after leaving some out (its band is θ∞'s).
+// all of them when that run stopped at rest after leaving some out (its band is θ∞'s).  With a
+// `certificate` (nominal runs toward a stable cycle), the first run stops at the separation from
+// which the rest of the motion is certified inside the band (CycleCertificate).
 template <class Simulate>
-Settle settled(const Simulate& simulate, const Parameters& p, const LimitCycle& cycle, const SettleOptions& o) {
+Settle settled(const Simulate& simulate, const Parameters& p, const LimitCycle& cycle, const SettleOptions& o,
+               const std::function<bool(const SimulationEvent&)>& certificate = {}) {
   std::vector<Sample> theta_o;
-  SimulationResult run = simulate(sampled(o, theta_o, moving_band(p, cycle, o.fraction * std::fabs(o.step))));
+  SimulationOptions first = sampled(o, theta_o, moving_band(p, cycle, o.fraction * std::fabs(o.step)));
+  double stopped = NAN;
+  if (certificate)
+    first.event_sink = [&certificate, &stopped](const SimulationEvent& e) {
+      if (!certificate(e)) return;
+      stopped = e.t;
+      throw InsideFromHere{};
+    };
+  SimulationResult run;
+  try {
+    run = simulate(first);
+  } catch (const InsideFromHere&) {
+    Settle s = judge(run, theta_o, p, cycle, o, true);
+    s.stopped_at = stopped;
+    return s;
+  }
   if (run.status == SimulationStatus::Rest && run.samples_left_out > 0) {
     theta_o.clear();
     run = simulate(sampled(o, theta_o, std::nullopt));
@@ -104,7 +191,10 @@ Settle settle_time(const ValidatedEffectModel& model, const LimitCycle& cycle, c
 Settle settle_time(const ValidatedEvaluator& evaluator, const LimitCycle& cycle, const SettleOptions& options) {
   if (options.step == 0 || options.samples < 1 || !(options.t_end > 0)) return {};
   const auto simulate = [&](const SimulationOptions& o) { return simulate_step(evaluator, options.step, o); };
-  return settled(simulate, evaluator.parameters(), cycle, options);
+  if (!options.stop_on_cycle || !CycleCertificate::applies(cycle)) return settled(simulate, evaluator.parameters(), cycle, options);
+  CycleCertificate certificate(evaluator, cycle, moving_band(evaluator.parameters(), cycle, options.fraction * std::fabs(options.step)));
+  return settled(simulate, evaluator.parameters(), cycle, options,
+                 [&certificate](const SimulationEvent& e) { return certificate.holds_after(e); });
 }
 
 }  // namespace backlash::numeric
