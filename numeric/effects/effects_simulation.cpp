@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <vector>
 
 namespace backlash::numeric {
 
@@ -114,6 +115,35 @@ bool spurious_separation(const Parameters& p, const ModeFlow& flow, double tau) 
   return std::fabs(z(0)) <= noise && std::fabs(z(1)) <= noise * std::sqrt(p.K / (p.Jm + p.JL));
 }
 
+// The constants of a witness's certified bounds (first_crossing.hpp, WitnessMode), kept per thread
+// for the last few (A, e): a mode is entered again and again with the same matrix and guards, and
+// building them per search was a third of a closed-form segment's cost (issue 19).  Of the
+// constants only c, eᵀc, eᵀA c and eᵀA² c depend on the forcing c (which moves with the start:
+// the drive folded in), and they are formed here as WitnessMode's constructor forms them; the
+// others (eᵀA^k, the balancing, μ∞, the norms) come from A and e alone.  Exact comparison of A
+// and e: a hit is the WitnessMode a rebuild would give, bit for bit
+// (tests/numeric/check_effects_engine_cost.cpp checks every member).
+WitnessMode witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e) {
+  thread_local std::vector<WitnessMode> cache;
+  thread_local std::size_t next = 0;
+  const auto same = [](const auto& x, const auto& y) { return x.rows() == y.rows() && x.cols() == y.cols() && x == y; };
+  for (const WitnessMode& m : cache) {
+    if (!same(m.A, A) || !same(m.e, e)) continue;
+    WitnessMode hit = m;
+    hit.c = c;
+    hit.ec = e.dot(c);
+    hit.eAc = hit.eA.dot(c);
+    hit.eA2c = hit.eA2.dot(c);
+    return hit;
+  }
+  constexpr std::size_t capacity = 32;
+  if (cache.size() < capacity) return cache.emplace_back(A, c, e);
+  cache[next] = WitnessMode(A, c, e);
+  const std::size_t at = next;
+  next = (next + 1) % capacity;
+  return cache[at];
+}
+
 // The certified search for one witness's first exit, advanced window by window.
 class ExitSearch {
  public:
@@ -125,6 +155,8 @@ class ExitSearch {
     lw_.level = -witness.f.constant;
     lw_.state = [&flow](double tau) { return flow.local(tau); };
     lw_.third_derivative_bound = flow.derivative_bound(lw_.e, 3);
+    // Without a stiff bound the search on a mode built once is the LinearWitness search, bit for bit.
+    if (!lw_.third_derivative_bound) mode_.emplace(witness_mode(lw_.A, lw_.c, lw_.e));
     const Start start = classify_start(flow, lw_, witness.f.magnitude, horizon, t_global);
     if (start.kind == StartKind::Never) finished_ = true;
     if (start.kind == StartKind::ExitNow) immediate_ = true;
@@ -136,7 +168,7 @@ class ExitSearch {
   /// The first exit in (from, until], or nothing there (the search then resumes at `until`).
   std::optional<Exit> search_until(double until) {
     while (!finished_ && from_ < until) {
-      const std::optional<Crossing> crossing = first_crossing(lw_, from_, until);
+      const std::optional<Crossing> crossing = search(until);
       if (!crossing) {
         from_ = until;
         return std::nullopt;
@@ -154,10 +186,20 @@ class ExitSearch {
   }
 
  private:
+  std::optional<Crossing> search(double until) const {
+    if (!mode_) return first_crossing(lw_, from_, until);
+    const auto sample = [this](double tau) {
+      WitnessSample s{flow_.local(tau), 0};
+      s.value = lw_.e.dot(s.x);
+      return s;
+    };
+    return first_crossing(*mode_, sample, lw_.level, from_, until);
+  }
   const Parameters& p_;
   const ModeFlow& flow_;
   Witness witness_;
   LinearWitness lw_;
+  std::optional<WitnessMode> mode_;  // the witness's constants, when the search needs no stiff bound
   double from_ = 0;
   bool finished_ = false, immediate_ = false;
 };
