@@ -158,6 +158,11 @@ class Engine {
   std::deque<double> impacts_;
 };
 
+/// The constants of a witness's certified bounds, WitnessMode(A, c, e) bit for bit, kept per
+/// thread for the last few (A, e) (effects_simulation.cpp): only the forcing's terms are formed
+/// again when a mode is entered with the same matrix and guard.
+WitnessMode witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e);
+
 /// The closed-form segment of mode `m` from `start` (effects_simulation.cpp) with `extra` guards
 /// besides the mode's own (Handover guards: their exit ends the segment without an exit);
 /// `left_zone` as ModeFunctionals::left_zone.

@@ -115,15 +115,13 @@ bool spurious_separation(const Parameters& p, const ModeFlow& flow, double tau) 
   return std::fabs(z(0)) <= noise && std::fabs(z(1)) <= noise * std::sqrt(p.K / (p.Jm + p.JL));
 }
 
-// The constants of a witness's certified bounds (first_crossing.hpp, WitnessMode), kept per thread
-// for the last few (A, e): a mode is entered again and again with the same matrix and guards, and
-// building them per search was a third of a closed-form segment's cost (issue 19).  Of the
-// constants only c, eᵀc, eᵀA c and eᵀA² c depend on the forcing c (which moves with the start:
-// the drive folded in), and they are formed here as WitnessMode's constructor forms them; the
-// others (eᵀA^k, the balancing, μ∞, the norms) come from A and e alone.  Exact comparison of A
-// and e: a hit is the WitnessMode a rebuild would give, bit for bit
-// (tests/numeric/check_effects_engine_cost.cpp checks every member).
-WitnessMode witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e) {
+}  // namespace
+
+// Only c, eᵀc, eᵀA c and eᵀA² c depend on the forcing c (which moves with the start: the drive
+// folded in); they are formed as WitnessMode's constructor forms them, the others (eᵀA^k, the
+// balancing, μ∞, the norms) come from A and e alone.  Exact comparison of A and e.  Building the
+// constants per search was a third of a closed-form segment's cost (issue 19).
+WitnessMode detail::witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e) {
   thread_local std::vector<WitnessMode> cache;
   thread_local std::size_t next = 0;
   const auto same = [](const auto& x, const auto& y) { return x.rows() == y.rows() && x.cols() == y.cols() && x == y; };
@@ -144,6 +142,8 @@ WitnessMode witness_mode(const SmallMatrix& A, const SmallVector& c, const Small
   return cache[at];
 }
 
+namespace {
+
 // The certified search for one witness's first exit, advanced window by window.
 class ExitSearch {
  public:
@@ -156,7 +156,7 @@ class ExitSearch {
     lw_.state = [&flow](double tau) { return flow.local(tau); };
     lw_.third_derivative_bound = flow.derivative_bound(lw_.e, 3);
     // Without a stiff bound the search on a mode built once is the LinearWitness search, bit for bit.
-    if (!lw_.third_derivative_bound) mode_.emplace(witness_mode(lw_.A, lw_.c, lw_.e));
+    if (!lw_.third_derivative_bound) mode_.emplace(detail::witness_mode(lw_.A, lw_.c, lw_.e));
     const Start start = classify_start(flow, lw_, witness.f.magnitude, horizon, t_global);
     if (start.kind == StartKind::Never) finished_ = true;
     if (start.kind == StartKind::ExitNow) immediate_ = true;
