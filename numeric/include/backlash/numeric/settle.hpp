@@ -17,17 +17,19 @@
 // time NaN).  A simulation that stopped early (chattering, event_limit, ... :
 // hybrid_simulation.hpp) gives that status and NaN — never a guess.
 //
-// Certified on the cycle (nominal model, a stable symmetric cycle without bounces): the
+// Stopped on the cycle (nominal model, a stable symmetric cycle without bounces): the
 // separations of the step response lie on the separation line, so from one with speed u the
 // motion is the half-cycle map g's (limit_cycle.hpp), and the later speeds are g(u), g(g(u)), ….
 // The response is stopped at the first separation whose speed u lies in an interval
 // I = [v* − r, v* + r] around the cycle's v* (r = |u − v*|) that g maps into itself (checked at
 // I's ends: same events, one recombination and a separation, and g(ends) in I, in the order of
 // g'(v*)'s sign) and whose ends' half cycles keep θo (and its mirror image about θR) inside the
-// band by the sample band's margin.  g, and θo's extremes over a half cycle, are taken monotone
+// band by the sample band's margin.  g, and θo's extremes over a half cycle, are ASSUMED monotone
 // on I (they are smooth there, with |g'(v*)| < 1; the checks at I's ends and at v* agree with
-// it); then every later sample lies inside the band, so the settle time and the status are those
-// of the run to t_end (checked against it: tests/numeric/check_settle_certified.cpp).
+// it, but nothing proves it between them): this stop is a check, not a certificate.  Under that
+// assumption every later sample lies inside the band, so the settle time and the status are
+// those of the run to t_end — as they were on every point checked against that run
+// (tests/numeric/check_settle_certified.cpp; stop_on_cycle = false runs to t_end).
 #pragma once
 
 #include "backlash/numeric/effects_simulation.hpp"
@@ -44,7 +46,8 @@ struct SettleOptions {
   int samples = 2000;      ///< h = t_end / samples
   double fraction = 0.02;  ///< tol = fraction·|A|
   /// Nominal runs toward a stable cycle: stop the step response at the separation from which
-  /// every later θo is certified inside the band (below); false: run it to t_end (checks).
+  /// every later θo stays inside the band by the check below ("Stopped on the cycle": a check
+  /// under a stated assumption, not a proof); false: run it to t_end.
   bool stop_on_cycle = true;
 };
 
@@ -52,8 +55,8 @@ struct Settle {
   std::string status = "no_step";  ///< "settled" | "not_settled" | "no_step" | a simulation status
   double time = NAN;               ///< [s]; NaN unless settled
   double band_low = NAN, band_high = NAN;  ///< the band [rad], absolute (θR included)
-  double stopped_at = NAN;  ///< [s] the separation at which the step response was stopped,
-                            ///< certified on its cycle; NaN when it ran to t_end or to rest
+  double stopped_at = NAN;  ///< [s] the separation at which the step response was stopped on
+                            ///< its cycle; NaN when it ran to t_end or to rest
 };
 
 /// The settle time of `model`'s step response; `cycle` is the point's limit-cycle search
