@@ -6,9 +6,7 @@
 #include <boost/math/tools/roots.hpp>
 
 #include <array>
-#include <bit>
 #include <cmath>
-#include <cstring>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -37,6 +35,21 @@ double log_norm(const SmallMatrix& A) {
   return A.rows() > 0 ? mu : 0.0;
 }
 
+// The first window of a search (WitnessMode::first_window): kWindowRates over the mode's fastest
+// rate, estimated as max_i |a_ii| + max_{i≠j} √|a_ij a_ji| — unchanged by a diagonal scaling of the
+// state (the units of θ and θ̇), ω for an oscillator's [[0, 1], [−ω², −2α]] plus its 2α.
+constexpr double kWindowRates = 4;
+
+double window_of(const SmallMatrix& A) {
+  double diagonal = 0, coupling = 0;
+  for (Eigen::Index i = 0; i < A.rows(); ++i) {
+    diagonal = std::max(diagonal, std::fabs(A(i, i)));
+    for (Eigen::Index j = 0; j < i; ++j) coupling = std::max(coupling, std::sqrt(std::fabs(A(i, j) * A(j, i))));
+  }
+  const double rate = diagonal + coupling;
+  return rate > 0 ? kWindowRates / rate : INFINITY;
+}
+
 // A stiff segment's state mixes scales: in contact x = (θ, θ̇) with θ̇ ~ √(K/J)·θ, and A has
 // the entry K/J.  Measured in ‖·‖∞ the growth bound e^{μ∞(A) h} then allows intervals of
 // 1/μ∞(A) ~ J/K (1e-12 s for K = 1e12) where the motion's time scale is √(J/K) (1e-6 s): the
@@ -53,6 +66,17 @@ constexpr double kBalanceGain = 16;
 // few ulps (times the closed forms' cancellation) they carry, so that the judgement never comes
 // near the tests it anticipates.
 constexpr double kSampleNoise = 1e-6;
+
+// An upper bound on e^x for x ≥ 0, rounding included: e^x ≤ 1 + x + x² on [0, 1.25] (equal at 0;
+// the difference's derivative 1 + 2x − e^x is ≥ 0 there), and the factor 1 + 2e-15 (9 ulps) covers
+// the rounding of the sum and of std::exp (< 1 ulp).  The search's bounds only need an upper
+// bound of the growth, and most of its intervals have μ⁺h ≤ 1: no call of exp.
+double growth_bound(double x) {
+  constexpr double kRounding = 1 + 2e-15;
+  if (!(x > 0)) return 1;
+  if (x <= 1) return (1 + x + x * x) * kRounding;
+  return std::exp(x) * kRounding;
+}
 
 // A witness on a mode, sampled through one closed-form evaluation per point.
 class Sampler {
@@ -98,15 +122,8 @@ class Sampler {
 
   double value(double t) const { return sample_(t).value - level_; }
 
-  // e^{μ⁺h}.  The intervals of a search have few distinct lengths (t_end − t_begin halved k
-  // times), so the last values are kept: the same h gives the same bits, one exp per length.
-  double growth(double h) const {
-    std::uint64_t bits;  // std::bit_cast, which the WebAssembly build's libc++ 14 lacks
-    std::memcpy(&bits, &h, sizeof bits);
-    GrowthEntry& entry = growth_cache_[(bits ^ (bits >> 29)) % growth_cache_.size()];
-    if (!(entry.h == h)) entry = {h, std::exp(std::max(0.0, m_.mu_A) * h)};
-    return entry.E;
-  }
+  // An upper bound on e^{μ⁺h} (growth_bound): a few flops, no exp, for the lengths of a search.
+  double growth(double h) const { return growth_bound(std::max(0.0, m_.mu_A) * h); }
 
   // sup |w'''| on [a.t, a.t + h]: w''' = eA² z = (eA² D⁻¹)(D z) and ‖D z(t)‖∞ ≤
   // e^{μ∞(DAD⁻¹)(t−a)} ‖D z(a)‖∞ (the supremum of e^{μ s} over s ∈ [0, h] is 1 when μ ≤ 0).
@@ -140,13 +157,9 @@ class Sampler {
   }
 
  private:
-  struct GrowthEntry {
-    double h = NAN, E = 0;
-  };
   const WitnessMode& m_;
   FunctionRef<WitnessSample(double)> sample_;
   double level_;
-  mutable std::array<GrowthEntry, 16> growth_cache_{};
 };
 
 bool same_sign(double x, double y) { return (x > 0 && y > 0) || (x < 0 && y < 0); }
@@ -176,84 +189,105 @@ struct End {
 
 Sample lazy(double t) { return {t, 0, 0, 0, 0, 0}; }
 
-// The root of w in [a, b] (a sign change, w monotone there or the interval at the resolution).
+// The root of w in [a, b]: a sign change, w monotone there (certified: the root is unique) or the
+// interval at the resolution.  Halley's iteration on the samples' w, w', w'' (one closed-form
+// evaluation per step), from the end nearer the root, kept inside the bracket (bisection when a
+// step leaves it).  A Halley step δ from t leaves an error of at most about K|δ|³ with
+// K = (w''/2w')² + sup|w'''|/(6|w'|) near t (the cubic term of its error), so the step is taken
+// without a further sample once 2K|δ|³ is below a quarter of the tolerance (time_tolerance
+// relative to max(t, time_unit)), or once |δ| itself is (the witness's rounding then decides).
 double root_in(const Sampler& W, const Sample& a, const Sample& b, const CrossingOptions& options) {
-  const auto f = [&W](double t) { return W.value(t); };
-  boost::uintmax_t iterations = 200;
   const double tolerance = options.time_tolerance, unit = W.mode().time_unit;
-  const auto root = boost::math::tools::toms748_solve(
-      f, a.t, b.t, a.w, b.w,
-      [tolerance, unit](double lo, double hi) { return hi - lo <= tolerance * std::max(unit, std::fabs(hi)); },
-      iterations);
-  return 0.5 * (root.first + root.second);
+  double lo = a.t, hi = b.t;
+  const bool rising = a.w < 0;  // w < 0 left of the root when rising
+  Sample s = std::fabs(a.w) <= std::fabs(b.w) ? a : b;
+  for (int iteration = 0; iteration < 200; ++iteration) {
+    double step = NAN;
+    if (s.w1 != 0) {
+      const double newton = -s.w / s.w1;
+      const double correction = 1 + 0.5 * newton * s.w2 / s.w1;  // Halley: 1 − w w″/(2w′²)
+      step = correction > 0.5 && correction < 2 ? newton / correction : newton;
+    }
+    const double width = tolerance * std::max(unit, std::fabs(s.t));
+    if (std::fabs(step) <= 0.25 * width) return s.t + step;
+    const double next = s.t + step;
+    if (next > lo && next < hi) {
+      const double curvature = 0.5 * s.w2 / s.w1;
+      const double K = curvature * curvature + W.third_bound(s, std::fabs(step)) / (6 * std::fabs(s.w1));
+      if (2 * K * std::fabs(step) * step * step <= 0.25 * width) return next;
+    } else {
+      const double mid = 0.5 * (lo + hi);
+      if (hi - lo <= width) return mid;
+      step = mid - s.t;
+    }
+    s = W.at(s.t + step);
+    if (s.w == 0) return s.t;
+    ((s.w < 0) == rising ? lo : hi) = s.t;
+  }
+  return 0.5 * (lo + hi);
 }
 
-// Depth-first, left half first.  The intervals still to examine tile [a, t_end] from the left,
-// so they are kept as their right ends (a stack whose top is the nearest) and the current left
-// end a: an interval decided hands its right end on as the next left end; a halved one pushes
-// its midpoint.  Inline storage: no allocation unless the bisection goes deeper than 96 levels.
-// Intervals that end by `clear_until` (certified_clearance) hold no zero: they are passed over
-// unsampled, as the whole subtree the search would have spent excluding them.
+// Depth-first, left half first, over windows: the first from t_begin has the mode's own length
+// (WitnessMode::first_window), each later one twice the one before, the last ending at t_end, so
+// a search's cost depends on the mode's time scale, not on t_end − t_begin (a search that meets
+// no crossing spends log₂ of the span over the first window on windows).  Within a window the
+// intervals still to examine tile [a, window's end] from the left, so they are kept as their right
+// ends (a stack whose top is the nearest) and the current left end a: an interval decided hands its
+// right end on as the next left end; a halved one pushes its midpoint.  Inline storage: no
+// allocation unless the bisection goes deeper than 96 levels.  With `clear_until`
+// (certified_clearance: w ≠ 0 on [t_begin, clear_until]) the search starts at clear_until.
 std::optional<Crossing> search(const Sampler& W, const std::function<double(double, double)>* third_derivative_bound,
                                double t_begin, double t_end, const CrossingOptions& options,
                                double clear_until = -INFINITY) {
+  if (clear_until > t_begin) t_begin = std::min(clear_until, t_end);
   if (!(t_end > t_begin)) return std::nullopt;
   const double min_length = options.min_interval * W.mode().time_unit;
   long examined = 0;
   boost::container::small_vector<End, 96> ends;
-  Sample a = lazy(t_begin);
-  bool a_known = false;
-  ends.push_back({lazy(t_end), false});
-  while (!ends.empty()) {
-    if (++examined > options.max_intervals)
-      throw SearchBudgetExhausted("the certified event search exhausted its budget of " +
-                                  std::to_string(options.max_intervals) + " intervals");
-    End& end = ends.back();
-    Sample& b = end.s;
-    if (b.t <= clear_until) {
-      a = b;
-      a_known = end.known;
-      ends.pop_back();
-      continue;
-    }
-    if (!a_known) {
-      a = W.at(a.t);
-      a_known = true;
-    }
-    const double h = b.t - a.t;
-    const bool halve = !third_derivative_bound && std::isfinite(a.w) && W.must_halve(a, h, min_length);
-    if (!halve && !end.known) {
-      b = W.at(b.t);
-      end.known = true;
-    }
-    if (!std::isfinite(a.w) || (!halve && !std::isfinite(b.w))) throw std::runtime_error("first_crossing: non-finite witness");
-    if (a.w == 0 && a.t > t_begin) return Crossing{a.t, false, examined};
-    if (halve) {
-      ends.push_back({lazy(a.t + 0.5 * h), false});
-      continue;
-    }
-    const double M3 = third_derivative_bound ? (*third_derivative_bound)(a.t, b.t) : W.third_bound(a, h);
-    const double M2 = 0.5 * (std::fabs(a.w2) + std::fabs(b.w2) + h * M3);
-    const double M1 = 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) + h * M2);
-    const bool sign_change = !same_sign(a.w, b.w);
-    const bool excluded = !sign_change && std::fabs(a.w) + std::fabs(b.w) > h * M1;
-    const bool monotone = !excluded && same_sign(a.w1, b.w1) && 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) - h * M2) > 0;
-    if (!excluded && (monotone || h < min_length)) {
-      if (sign_change) {
-        if (b.w == 0) return Crossing{b.t, false, examined};
-        return Crossing{root_in(W, a, b, options), false, examined};
+  Sample a = W.at(t_begin);
+  double window = W.mode().first_window;
+  while (a.t < t_end) {
+    ends.push_back({lazy(t_end - a.t <= window ? t_end : a.t + window), false});
+    window *= 2;
+    while (!ends.empty()) {
+      if (++examined > options.max_intervals)
+        throw SearchBudgetExhausted("the certified event search exhausted its budget of " +
+                                    std::to_string(options.max_intervals) + " intervals");
+      End& end = ends.back();
+      Sample& b = end.s;
+      const double h = b.t - a.t;
+      const bool halve = !third_derivative_bound && std::isfinite(a.w) && W.must_halve(a, h, min_length);
+      if (!halve && !end.known) {
+        b = W.at(b.t);
+        end.known = true;
       }
-      // Uncertified down to the resolution: the witness touches the level here.
-      if (!monotone) return Crossing{std::fabs(a.w) <= std::fabs(b.w) ? a.t : b.t, true, examined};
+      if (!std::isfinite(a.w) || (!halve && !std::isfinite(b.w))) throw std::runtime_error("first_crossing: non-finite witness");
+      if (a.w == 0 && a.t > t_begin) return Crossing{a.t, false, examined};
+      if (halve) {
+        ends.push_back({lazy(a.t + 0.5 * h), false});
+        continue;
+      }
+      const double M3 = third_derivative_bound ? (*third_derivative_bound)(a.t, b.t) : W.third_bound(a, h);
+      const double M2 = 0.5 * (std::fabs(a.w2) + std::fabs(b.w2) + h * M3);
+      const double M1 = 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) + h * M2);
+      const bool sign_change = !same_sign(a.w, b.w);
+      const bool excluded = !sign_change && std::fabs(a.w) + std::fabs(b.w) > h * M1;
+      const bool monotone = !excluded && same_sign(a.w1, b.w1) && 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) - h * M2) > 0;
+      if (!excluded && (monotone || h < min_length)) {
+        if (sign_change) {
+          if (b.w == 0) return Crossing{b.t, false, examined};
+          return Crossing{root_in(W, a, b, options), false, examined};
+        }
+        // Uncertified down to the resolution: the witness touches the level here.
+        if (!monotone) return Crossing{std::fabs(a.w) <= std::fabs(b.w) ? a.t : b.t, true, examined};
+      }
+      if (excluded || monotone) {  // no root in [a, b] (monotone without a sign change): on to the next interval
+        a = b;
+        ends.pop_back();
+        continue;
+      }
+      ends.push_back({W.at(a.t + 0.5 * h), true});
     }
-    if (excluded || monotone) {  // no root in [a, b] (monotone without a sign change): on to the next interval
-      a = b;
-      a_known = true;
-      ends.pop_back();
-      continue;
-    }
-    const Sample m = W.at(a.t + 0.5 * h);
-    ends.push_back({m, true});
   }
   return std::nullopt;
 }
@@ -276,6 +310,7 @@ WitnessMode::WitnessMode(const SmallMatrix& A_, const SmallVector& c_, const Sma
   eAc = eA.dot(c);
   eA2c = eA2.dot(c);
   mu_A = log_norm(A);
+  first_window = window_of(A);
   scale = SmallVector::Ones(A.rows());
   if (mu_A > 0) {
     const SmallVector d = detail::balancing(A);

@@ -104,6 +104,7 @@ struct WitnessMode {
   double norm_e_plain, norm_eA, norm_A;  ///< ‖eᵀ‖₁, ‖eᵀA‖₁, ‖D A‖∞ (rounding scales)
   double inverse_scale;  ///< max 1/D_i
   double time_unit;  ///< as LinearWitness::time_unit
+  double first_window;  ///< the length of a search's first window (the mode's time scale), s
 };
 
 struct Crossing {
