@@ -67,15 +67,23 @@ constexpr double kBalanceGain = 16;
 // near the tests it anticipates.
 constexpr double kSampleNoise = 1e-6;
 
-// An upper bound on e^x for x ≥ 0, rounding included: e^x ≤ 1 + x + x² on [0, 1.25] (equal at 0;
-// the difference's derivative 1 + 2x − e^x is ≥ 0 there), and the factor 1 + 2e-15 (9 ulps) covers
-// the rounding of the sum and of std::exp (< 1 ulp).  The search's bounds only need an upper
-// bound of the growth, and most of its intervals have μ⁺h ≤ 1: no call of exp.
+// An upper bound on e^x for x ≥ 0, rounding included, without exp: with y = x/2^k ≤ 1/4,
+// e^y ≤ 1 + y + y²/2 + 0.22 y³ (Taylor's remainder y³e^y/6 ≤ 0.214 y³), squared k times; each
+// squaring at most doubles the relative rounding (≈ 2^k · 3 ulps ≤ 1.4e-15 (1 + x) in all), and
+// the factor 1 + 1e-14 (1 + x) covers it.  The search's bounds only need an upper bound of the
+// growth; overflow (x > 700) gives infinity, which fails every test (the interval is halved).
 double growth_bound(double x) {
-  constexpr double kRounding = 1 + 2e-15;
   if (!(x > 0)) return 1;
-  if (x <= 1) return (1 + x + x * x) * kRounding;
-  return std::exp(x) * kRounding;
+  if (!(x <= 700)) return INFINITY;
+  int k = 0;
+  double y = x;
+  while (y > 0.25) {
+    y *= 0.5;
+    ++k;
+  }
+  double e = 1 + y * (1 + y * (0.5 + 0.22 * y));
+  for (int i = 0; i < k; ++i) e *= e;
+  return e * (1 + 1e-14 * (1 + x));
 }
 
 // A witness on a mode, sampled through one closed-form evaluation per point.
@@ -163,6 +171,37 @@ class Sampler {
 };
 
 bool same_sign(double x, double y) { return (x > 0 && y > 0) || (x < 0 && y < 0); }
+
+// Whether q(s) = w0 + w1 s + w2 s²/2 keeps the sign of w0 on [0, L] with |q| > r: its smallest
+// value (times that sign) is at an end or at its vertex −w1/w2.
+bool quadratic_clear(double w0, double w1, double w2, double L, double r) {
+  const double sign = w0 > 0 ? 1 : -1;
+  if (!(sign * w0 > r)) return false;
+  const double at_end = sign * (w0 + L * (w1 + 0.5 * L * w2));
+  if (!(at_end > r)) return false;
+  const double vertex = w2 != 0 ? -w1 / w2 : -1;
+  return !(vertex > 0 && vertex < L) || sign * (w0 + 0.5 * vertex * w1) > r;  // q(s*) = w0 + s* w1/2
+}
+
+// The second pair of tests, by Taylor's theorem with |w'''| ≤ M3 on [a, b] (h = b − a), each half
+// from its own end: on [a, a + h/2] w(a + s) = w(a) + w'(a) s + w''(a) s²/2 + ρ, |ρ| ≤ M3 (h/2)³/6,
+// and w'(a + s) = w'(a) + w''(a) s + ρ', |ρ'| ≤ M3 (h/2)²/2; on [a + h/2, b] the same from b
+// with s → −s.  No zero in [a, b] when both quadratics keep one sign clear of ρ; w monotone when
+// both lines do.  The curvature is used, so an interval passes at about (|w|/M3)^{1/3}, where
+// the mean-value tests above need |w| > h·M1 with M1 ≳ |w'| + h|w''|.
+bool taylor_excluded(const Sample& a, const Sample& b, double h, double M3) {
+  const double L = 0.5 * h, rho = M3 * L * L * L / 6;
+  return same_sign(a.w, b.w) && quadratic_clear(a.w, a.w1, a.w2, L, rho) && quadratic_clear(b.w, -b.w1, b.w2, L, rho);
+}
+
+bool taylor_monotone(const Sample& a, const Sample& b, double h, double M3) {
+  const double L = 0.5 * h, rho = M3 * L * L / 2;
+  const auto clear = [rho, L](double d, double dd) {
+    const double sign = d > 0 ? 1 : -1;
+    return sign * d > rho && sign * (d + L * dd) > rho;
+  };
+  return same_sign(a.w1, b.w1) && clear(a.w1, a.w2) && clear(b.w1, -b.w2);
+}
 
 // Whether w''(0) is resolved from the error of the start's time.  The flight starts at an event
 // located to a tolerance δt (CrossingOptions::time_tolerance relative to the time unit, times
@@ -256,7 +295,7 @@ std::optional<Crossing> search(const Sampler& W, const std::function<double(doub
       End& end = ends.back();
       Sample& b = end.s;
       const double h = b.t - a.t;
-      const bool halve = !third_derivative_bound && std::isfinite(a.w) && W.must_halve(a, h, min_length);
+      const bool halve = !end.known && !third_derivative_bound && std::isfinite(a.w) && W.must_halve(a, h, min_length);
       if (!halve && !end.known) {
         b = W.at(b.t);
         end.known = true;
@@ -271,8 +310,10 @@ std::optional<Crossing> search(const Sampler& W, const std::function<double(doub
       const double M2 = 0.5 * (std::fabs(a.w2) + std::fabs(b.w2) + h * M3);
       const double M1 = 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) + h * M2);
       const bool sign_change = !same_sign(a.w, b.w);
-      const bool excluded = !sign_change && std::fabs(a.w) + std::fabs(b.w) > h * M1;
-      const bool monotone = !excluded && same_sign(a.w1, b.w1) && 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) - h * M2) > 0;
+      const bool excluded =
+          !sign_change && (std::fabs(a.w) + std::fabs(b.w) > h * M1 || taylor_excluded(a, b, h, M3));
+      const bool monotone = !excluded && same_sign(a.w1, b.w1) &&
+                            (0.5 * (std::fabs(a.w1) + std::fabs(b.w1) - h * M2) > 0 || taylor_monotone(a, b, h, M3));
       if (!excluded && (monotone || h < min_length)) {
         if (sign_change) {
           if (b.w == 0) return Crossing{b.t, false, examined};
@@ -340,14 +381,14 @@ std::optional<double> certified_departure(const WitnessMode& W, const SmallVecto
   if (std::fabs(second) > 1e-12 * std::max(1.0, z0) && quadratic_resolved(second, third, W.time_unit)) {
     double t0 = std::sqrt(2 * noise / scale);
     for (int attempt = 0; attempt < 60; ++attempt, t0 *= 0.5)
-      if (std::fabs(second) > t0 * W.norm_eA2 * std::exp(growth * t0) * z0) return t0;
+      if (std::fabs(second) > t0 * W.norm_eA2 * growth_bound(growth * t0) * z0) return t0;
     return std::nullopt;
   }
   if (third == 0 || !std::isfinite(third)) return std::nullopt;
   // w''' dominant (w'' = 0): |w'''(0)| > t0 sup|w''''|, sup|w''''| ≤ ‖eA³‖ e^{μ t0} z0.
   double t0 = std::cbrt(6 * noise / std::fabs(third));
   for (int attempt = 0; attempt < 60; ++attempt, t0 *= 0.5)
-    if (std::fabs(third) > t0 * W.norm_eA3 * std::exp(growth * t0) * z0) return t0;
+    if (std::fabs(third) > t0 * W.norm_eA3 * growth_bound(growth * t0) * z0) return t0;
   return std::nullopt;
 }
 
@@ -355,7 +396,7 @@ std::optional<double> certified_departure(const WitnessMode& W, const SmallVecto
 double last_within(double first_guess, double t0, double bound, double growth, double z0, double limit) {
   double t1 = first_guess;
   for (int attempt = 0; attempt < 60 && t1 > t0; ++attempt, t1 *= 0.5)
-    if (t1 * bound * std::exp(growth * t1) * z0 <= limit) return t1;
+    if (t1 * bound * growth_bound(growth * t1) * z0 <= limit) return t1;
   return 0;
 }
 
