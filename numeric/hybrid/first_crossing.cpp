@@ -1,14 +1,13 @@
 #include "backlash/numeric/first_crossing.hpp"
 
 #include "hybrid/balancing.hpp"
+#include "hybrid/gap_events.hpp"
 
 #include <boost/container/small_vector.hpp>
 #include <boost/math/tools/roots.hpp>
 
 #include <array>
-#include <bit>
 #include <cmath>
-#include <cstring>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -37,6 +36,21 @@ double log_norm(const SmallMatrix& A) {
   return A.rows() > 0 ? mu : 0.0;
 }
 
+// The first window of a search (WitnessMode::first_window): kWindowRates over the mode's fastest
+// rate, estimated as max_i |a_ii| + max_{i≠j} √|a_ij a_ji| — unchanged by a diagonal scaling of the
+// state (the units of θ and θ̇), ω for an oscillator's [[0, 1], [−ω², −2α]] plus its 2α.
+constexpr double kWindowRates = 4;
+
+double window_of(const SmallMatrix& A) {
+  double diagonal = 0, coupling = 0;
+  for (Eigen::Index i = 0; i < A.rows(); ++i) {
+    diagonal = std::max(diagonal, std::fabs(A(i, i)));
+    for (Eigen::Index j = 0; j < i; ++j) coupling = std::max(coupling, std::sqrt(std::fabs(A(i, j) * A(j, i))));
+  }
+  const double rate = diagonal + coupling;
+  return rate > 0 ? kWindowRates / rate : INFINITY;
+}
+
 // A stiff segment's state mixes scales: in contact x = (θ, θ̇) with θ̇ ~ √(K/J)·θ, and A has
 // the entry K/J.  Measured in ‖·‖∞ the growth bound e^{μ∞(A) h} then allows intervals of
 // 1/μ∞(A) ~ J/K (1e-12 s for K = 1e12) where the motion's time scale is √(J/K) (1e-6 s): the
@@ -53,6 +67,25 @@ constexpr double kBalanceGain = 16;
 // few ulps (times the closed forms' cancellation) they carry, so that the judgement never comes
 // near the tests it anticipates.
 constexpr double kSampleNoise = 1e-6;
+
+// An upper bound on e^x for x ≥ 0, rounding included, without exp: with y = x/2^k ≤ 1/4,
+// e^y ≤ 1 + y + y²/2 + 0.22 y³ (Taylor's remainder y³e^y/6 ≤ 0.214 y³), squared k times; each
+// squaring at most doubles the relative rounding (≈ 2^k · 3 ulps ≤ 1.4e-15 (1 + x) in all), and
+// the factor 1 + 1e-14 (1 + x) covers it.  The search's bounds only need an upper bound of the
+// growth; overflow (x > 700) gives infinity, which fails every test (the interval is halved).
+double growth_bound(double x) {
+  if (!(x > 0)) return 1;
+  if (!(x <= 700)) return INFINITY;
+  int k = 0;
+  double y = x;
+  while (y > 0.25) {
+    y *= 0.5;
+    ++k;
+  }
+  double e = 1 + y * (1 + y * (0.5 + 0.22 * y));
+  for (int i = 0; i < k; ++i) e *= e;
+  return e * (1 + 1e-14 * (1 + x));
+}
 
 // A witness on a mode, sampled through one closed-form evaluation per point.
 class Sampler {
@@ -98,15 +131,8 @@ class Sampler {
 
   double value(double t) const { return sample_(t).value - level_; }
 
-  // e^{μ⁺h}.  The intervals of a search have few distinct lengths (t_end − t_begin halved k
-  // times), so the last values are kept: the same h gives the same bits, one exp per length.
-  double growth(double h) const {
-    std::uint64_t bits;  // std::bit_cast, which the WebAssembly build's libc++ 14 lacks
-    std::memcpy(&bits, &h, sizeof bits);
-    GrowthEntry& entry = growth_cache_[(bits ^ (bits >> 29)) % growth_cache_.size()];
-    if (!(entry.h == h)) entry = {h, std::exp(std::max(0.0, m_.mu_A) * h)};
-    return entry.E;
-  }
+  // An upper bound on e^{μ⁺h} (growth_bound): a few flops, no exp, for the lengths of a search.
+  double growth(double h) const { return growth_bound(std::max(0.0, m_.mu_A) * h); }
 
   // sup |w'''| on [a.t, a.t + h]: w''' = eA² z = (eA² D⁻¹)(D z) and ‖D z(t)‖∞ ≤
   // e^{μ∞(DAD⁻¹)(t−a)} ‖D z(a)‖∞ (the supremum of e^{μ s} over s ∈ [0, h] is 1 when μ ≤ 0).
@@ -140,16 +166,43 @@ class Sampler {
   }
 
  private:
-  struct GrowthEntry {
-    double h = NAN, E = 0;
-  };
   const WitnessMode& m_;
   FunctionRef<WitnessSample(double)> sample_;
   double level_;
-  mutable std::array<GrowthEntry, 16> growth_cache_{};
 };
 
 bool same_sign(double x, double y) { return (x > 0 && y > 0) || (x < 0 && y < 0); }
+
+// Whether q(s) = w0 + w1 s + w2 s²/2 keeps the sign of w0 on [0, L] with |q| > r: its smallest
+// value (times that sign) is at an end or at its vertex −w1/w2.
+bool quadratic_clear(double w0, double w1, double w2, double L, double r) {
+  const double sign = w0 > 0 ? 1 : -1;
+  if (!(sign * w0 > r)) return false;
+  const double at_end = sign * (w0 + L * (w1 + 0.5 * L * w2));
+  if (!(at_end > r)) return false;
+  const double vertex = w2 != 0 ? -w1 / w2 : -1;
+  return !(vertex > 0 && vertex < L) || sign * (w0 + 0.5 * vertex * w1) > r;  // q(s*) = w0 + s* w1/2
+}
+
+// The second pair of tests, by Taylor's theorem with |w'''| ≤ M3 on [a, b] (h = b − a), each half
+// from its own end: on [a, a + h/2] w(a + s) = w(a) + w'(a) s + w''(a) s²/2 + ρ, |ρ| ≤ M3 (h/2)³/6,
+// and w'(a + s) = w'(a) + w''(a) s + ρ', |ρ'| ≤ M3 (h/2)²/2; on [a + h/2, b] the same from b
+// with s → −s.  No zero in [a, b] when both quadratics keep one sign clear of ρ; w monotone when
+// both lines do.  The curvature is used, so an interval passes at about (|w|/M3)^{1/3}, where
+// the mean-value tests above need |w| > h·M1 with M1 ≳ |w'| + h|w''|.
+bool taylor_excluded(double wa, const Sample& a, double wb, const Sample& b, double h, double M3) {
+  const double L = 0.5 * h, rho = M3 * L * L * L / 6;
+  return same_sign(wa, wb) && quadratic_clear(wa, a.w1, a.w2, L, rho) && quadratic_clear(wb, -b.w1, b.w2, L, rho);
+}
+
+bool taylor_monotone(const Sample& a, const Sample& b, double h, double M3) {
+  const double L = 0.5 * h, rho = M3 * L * L / 2;
+  const auto clear = [rho, L](double d, double dd) {
+    const double sign = d > 0 ? 1 : -1;
+    return sign * d > rho && sign * (d + L * dd) > rho;
+  };
+  return same_sign(a.w1, b.w1) && clear(a.w1, a.w2) && clear(b.w1, -b.w2);
+}
 
 // Whether w''(0) is resolved from the error of the start's time.  The flight starts at an event
 // located to a tolerance δt (CrossingOptions::time_tolerance relative to the time unit, times
@@ -176,86 +229,165 @@ struct End {
 
 Sample lazy(double t) { return {t, 0, 0, 0, 0, 0}; }
 
-// The root of w in [a, b] (a sign change, w monotone there or the interval at the resolution).
-double root_in(const Sampler& W, const Sample& a, const Sample& b, const CrossingOptions& options) {
-  const auto f = [&W](double t) { return W.value(t); };
-  boost::uintmax_t iterations = 200;
+// The root of w in [a, b]: a sign change, w monotone there (certified: the root is unique) or the
+// interval at the resolution.  Halley's iteration on the samples' w, w', w'' (one closed-form
+// evaluation per step), from the end nearer the root, kept inside the bracket (bisection when a
+// step leaves it).  A Halley step δ from t leaves an error of at most about K|δ|³ with
+// K = (w''/2w')² + sup|w'''|/(6|w'|) near t (the cubic term of its error), so the step is taken
+// without a further sample once 2K|δ|³ is below a quarter of the tolerance (time_tolerance
+// relative to max(t, time_unit)), or once |δ| itself is (the witness's rounding then decides).
+double root_in(const Sampler& W, Sample a, Sample b, const CrossingOptions& options, double offset = 0) {
   const double tolerance = options.time_tolerance, unit = W.mode().time_unit;
-  const auto root = boost::math::tools::toms748_solve(
-      f, a.t, b.t, a.w, b.w,
-      [tolerance, unit](double lo, double hi) { return hi - lo <= tolerance * std::max(unit, std::fabs(hi)); },
-      iterations);
-  return 0.5 * (root.first + root.second);
+  a.w += offset;
+  b.w += offset;
+  double lo = a.t, hi = b.t;
+  const bool rising = a.w < 0;  // w < 0 left of the root when rising
+  Sample s = std::fabs(a.w) <= std::fabs(b.w) ? a : b;
+  for (int iteration = 0; iteration < 200; ++iteration) {
+    double step = NAN;
+    if (s.w1 != 0) {
+      const double newton = -s.w / s.w1;
+      const double correction = 1 + 0.5 * newton * s.w2 / s.w1;  // Halley: 1 − w w″/(2w′²)
+      step = correction > 0.5 && correction < 2 ? newton / correction : newton;
+    }
+    const double width = tolerance * std::max(unit, std::fabs(s.t));
+    if (std::fabs(step) <= 0.25 * width) return s.t + step;
+    const double next = s.t + step;
+    if (next > lo && next < hi) {
+      const double curvature = 0.5 * s.w2 / s.w1;
+      const double K = curvature * curvature + W.third_bound(s, std::fabs(step)) / (6 * std::fabs(s.w1));
+      if (2 * K * std::fabs(step) * step * step <= 0.25 * width) return next;
+    } else {
+      const double mid = 0.5 * (lo + hi);
+      if (hi - lo <= width) return mid;
+      step = mid - s.t;
+    }
+    s = W.at(s.t + step);
+    s.w += offset;
+    if (s.w == 0) return s.t;
+    ((s.w < 0) == rising ? lo : hi) = s.t;
+  }
+  return 0.5 * (lo + hi);
 }
 
-// Depth-first, left half first.  The intervals still to examine tile [a, t_end] from the left,
-// so they are kept as their right ends (a stack whose top is the nearest) and the current left
-// end a: an interval decided hands its right end on as the next left end; a halved one pushes
-// its midpoint.  Inline storage: no allocation unless the bisection goes deeper than 96 levels.
-// Intervals that end by `clear_until` (certified_clearance) hold no zero: they are passed over
-// unsampled, as the whole subtree the search would have spent excluding them.
-std::optional<Crossing> search(const Sampler& W, const std::function<double(double, double)>* third_derivative_bound,
-                               double t_begin, double t_end, const CrossingOptions& options,
-                               double clear_until = -INFINITY) {
+// A second level a search may look for at once (first_crossing_of_two_levels): w − second =
+// (w − level) + offset, active from `from` on (before it the caller knows it has no zero).
+struct SecondLevel {
+  double offset, from;
+};
+
+// A crossing and which level it is of.
+struct LevelCrossing {
+  Crossing crossing;
+  bool second = false;
+};
+
+// What the search does with an interval [a, b] (both ends sampled): on to the next, bisect, or stop
+// at a crossing.
+enum class Step { Next, Bisect, Found };
+struct Decision {
+  Step step;
+  LevelCrossing found{};
+};
+
+// The tests of first_crossing.hpp on [a, b] for the values wa, wb of one level's witness.
+bool excluded_level(double wa, double wb, const Sample& a, const Sample& b, double h, double M1, double M3) {
+  return same_sign(wa, wb) && (std::fabs(wa) + std::fabs(wb) > h * M1 || taylor_excluded(wa, a, wb, b, h, M3));
+}
+
+Decision decide(const Sampler& W, const Sample& a, const Sample& b, double M3, double min_length, const SecondLevel* second,
+                const CrossingOptions& options, long examined) {
+  const double h = b.t - a.t;
+  const double M2 = 0.5 * (std::fabs(a.w2) + std::fabs(b.w2) + h * M3);
+  const double M1 = 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) + h * M2);
+  const double offset = second ? second->offset : 0;
+  const bool active[2] = {true, second && b.t > second->from};
+  bool excluded[2];
+  for (int k = 0; k < 2; ++k)
+    excluded[k] = !active[k] || excluded_level(a.w + k * offset, b.w + k * offset, a, b, h, M1, M3);
+  if (excluded[0] && excluded[1]) return {Step::Next};
+  const bool monotone = same_sign(a.w1, b.w1) &&
+                        (0.5 * (std::fabs(a.w1) + std::fabs(b.w1) - h * M2) > 0 || taylor_monotone(a, b, h, M3));
+  if (!monotone && !(h < min_length)) return {Step::Bisect};
+  std::optional<LevelCrossing> first;
+  for (int k = 0; k < 2; ++k) {
+    const double wa = a.w + k * offset, wb = b.w + k * offset;
+    if (excluded[k] || same_sign(wa, wb)) continue;
+    const double t = wb == 0 ? b.t : root_in(W, a, b, options, k * offset);
+    if (!first || t < first->crossing.t) first = LevelCrossing{Crossing{t, false, examined}, k == 1};
+  }
+  if (first) return {Step::Found, *first};
+  if (monotone) return {Step::Next};  // no root in [a, b]: monotone without a sign change
+  // Uncertified down to the resolution: the witness touches the level here.
+  const int k = excluded[0] ? 1 : 0;
+  const double wa = a.w + k * offset, wb = b.w + k * offset;
+  return {Step::Found, LevelCrossing{Crossing{std::fabs(wa) <= std::fabs(wb) ? a.t : b.t, true, examined}, k == 1}};
+}
+
+// Depth-first, left half first, over windows: the first from t_begin has the mode's own length
+// (WitnessMode::first_window), each later one twice the one before, the last ending at t_end, so
+// a search's cost depends on the mode's time scale, not on t_end − t_begin (a search that meets
+// no crossing spends log₂ of the span over the first window on windows).  Within a window the
+// intervals still to examine tile [a, window's end] from the left, so they are kept as their right
+// ends (a stack whose top is the nearest) and the current left end a: an interval decided hands its
+// right end on as the next left end; a halved one pushes its midpoint (an interval across a second
+// level's start, its start).  Inline storage: no allocation unless the bisection goes deeper than
+// 96 levels.  With `clear_until` (certified_clearance: w ≠ 0 on [t_begin, clear_until]) the search
+// starts at clear_until.
+std::optional<LevelCrossing> search(const Sampler& W, const std::function<double(double, double)>* third_derivative_bound,
+                                    double t_begin, double t_end, const CrossingOptions& options,
+                                    double clear_until = -INFINITY, const SecondLevel* second = nullptr) {
+  if (clear_until > t_begin) t_begin = std::min(clear_until, t_end);
   if (!(t_end > t_begin)) return std::nullopt;
   const double min_length = options.min_interval * W.mode().time_unit;
   long examined = 0;
   boost::container::small_vector<End, 96> ends;
-  Sample a = lazy(t_begin);
-  bool a_known = false;
-  ends.push_back({lazy(t_end), false});
-  while (!ends.empty()) {
-    if (++examined > options.max_intervals)
-      throw SearchBudgetExhausted("the certified event search exhausted its budget of " +
-                                  std::to_string(options.max_intervals) + " intervals");
-    End& end = ends.back();
-    Sample& b = end.s;
-    if (b.t <= clear_until) {
-      a = b;
-      a_known = end.known;
-      ends.pop_back();
-      continue;
-    }
-    if (!a_known) {
-      a = W.at(a.t);
-      a_known = true;
-    }
-    const double h = b.t - a.t;
-    const bool halve = !third_derivative_bound && std::isfinite(a.w) && W.must_halve(a, h, min_length);
-    if (!halve && !end.known) {
-      b = W.at(b.t);
-      end.known = true;
-    }
-    if (!std::isfinite(a.w) || (!halve && !std::isfinite(b.w))) throw std::runtime_error("first_crossing: non-finite witness");
-    if (a.w == 0 && a.t > t_begin) return Crossing{a.t, false, examined};
-    if (halve) {
-      ends.push_back({lazy(a.t + 0.5 * h), false});
-      continue;
-    }
-    const double M3 = third_derivative_bound ? (*third_derivative_bound)(a.t, b.t) : W.third_bound(a, h);
-    const double M2 = 0.5 * (std::fabs(a.w2) + std::fabs(b.w2) + h * M3);
-    const double M1 = 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) + h * M2);
-    const bool sign_change = !same_sign(a.w, b.w);
-    const bool excluded = !sign_change && std::fabs(a.w) + std::fabs(b.w) > h * M1;
-    const bool monotone = !excluded && same_sign(a.w1, b.w1) && 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) - h * M2) > 0;
-    if (!excluded && (monotone || h < min_length)) {
-      if (sign_change) {
-        if (b.w == 0) return Crossing{b.t, false, examined};
-        return Crossing{root_in(W, a, b, options), false, examined};
+  Sample a = W.at(t_begin);
+  double window = W.mode().first_window;
+  while (a.t < t_end) {
+    ends.push_back({lazy(t_end - a.t <= window ? t_end : a.t + window), false});
+    window *= 2;
+    while (!ends.empty()) {
+      if (++examined > options.max_intervals)
+        throw SearchBudgetExhausted("the certified event search exhausted its budget of " +
+                                    std::to_string(options.max_intervals) + " intervals");
+      End& end = ends.back();
+      Sample& b = end.s;
+      const double h = b.t - a.t;
+      if (second && a.t < second->from && b.t > second->from) {
+        ends.push_back({lazy(second->from), false});
+        continue;
       }
-      // Uncertified down to the resolution: the witness touches the level here.
-      if (!monotone) return Crossing{std::fabs(a.w) <= std::fabs(b.w) ? a.t : b.t, true, examined};
-    }
-    if (excluded || monotone) {  // no root in [a, b] (monotone without a sign change): on to the next interval
+      const bool halve = !end.known && !third_derivative_bound && std::isfinite(a.w) && W.must_halve(a, h, min_length);
+      if (!halve && !end.known) {
+        b = W.at(b.t);
+        end.known = true;
+      }
+      if (!std::isfinite(a.w) || (!halve && !std::isfinite(b.w))) throw std::runtime_error("first_crossing: non-finite witness");
+      if (a.w == 0 && a.t > t_begin) return LevelCrossing{Crossing{a.t, false, examined}, false};
+      if (second && a.w + second->offset == 0 && a.t > second->from)
+        return LevelCrossing{Crossing{a.t, false, examined}, true};
+      if (halve) {
+        ends.push_back({lazy(a.t + 0.5 * h), false});
+        continue;
+      }
+      const double M3 = third_derivative_bound ? (*third_derivative_bound)(a.t, b.t) : W.third_bound(a, h);
+      const Decision d = decide(W, a, b, M3, min_length, second, options, examined);
+      if (d.step == Step::Found) return d.found;
+      if (d.step == Step::Bisect) {
+        ends.push_back({W.at(a.t + 0.5 * h), true});
+        continue;
+      }
       a = b;
-      a_known = true;
       ends.pop_back();
-      continue;
     }
-    const Sample m = W.at(a.t + 0.5 * h);
-    ends.push_back({m, true});
   }
   return std::nullopt;
+}
+
+std::optional<Crossing> crossing_of(const std::optional<LevelCrossing>& c) {
+  if (!c) return std::nullopt;
+  return c->crossing;
 }
 
 // The LinearWitness form as a sampler: x = state(t), value = value(t) or eᵀx.
@@ -276,6 +408,7 @@ WitnessMode::WitnessMode(const SmallMatrix& A_, const SmallVector& c_, const Sma
   eAc = eA.dot(c);
   eA2c = eA2.dot(c);
   mu_A = log_norm(A);
+  first_window = window_of(A);
   scale = SmallVector::Ones(A.rows());
   if (mu_A > 0) {
     const SmallVector d = detail::balancing(A);
@@ -305,14 +438,14 @@ std::optional<double> certified_departure(const WitnessMode& W, const SmallVecto
   if (std::fabs(second) > 1e-12 * std::max(1.0, z0) && quadratic_resolved(second, third, W.time_unit)) {
     double t0 = std::sqrt(2 * noise / scale);
     for (int attempt = 0; attempt < 60; ++attempt, t0 *= 0.5)
-      if (std::fabs(second) > t0 * W.norm_eA2 * std::exp(growth * t0) * z0) return t0;
+      if (std::fabs(second) > t0 * W.norm_eA2 * growth_bound(growth * t0) * z0) return t0;
     return std::nullopt;
   }
   if (third == 0 || !std::isfinite(third)) return std::nullopt;
   // w''' dominant (w'' = 0): |w'''(0)| > t0 sup|w''''|, sup|w''''| ≤ ‖eA³‖ e^{μ t0} z0.
   double t0 = std::cbrt(6 * noise / std::fabs(third));
   for (int attempt = 0; attempt < 60; ++attempt, t0 *= 0.5)
-    if (std::fabs(third) > t0 * W.norm_eA3 * std::exp(growth * t0) * z0) return t0;
+    if (std::fabs(third) > t0 * W.norm_eA3 * growth_bound(growth * t0) * z0) return t0;
   return std::nullopt;
 }
 
@@ -320,7 +453,7 @@ std::optional<double> certified_departure(const WitnessMode& W, const SmallVecto
 double last_within(double first_guess, double t0, double bound, double growth, double z0, double limit) {
   double t1 = first_guess;
   for (int attempt = 0; attempt < 60 && t1 > t0; ++attempt, t1 *= 0.5)
-    if (t1 * bound * std::exp(growth * t1) * z0 <= limit) return t1;
+    if (t1 * bound * growth_bound(growth * t1) * z0 <= limit) return t1;
   return 0;
 }
 
@@ -353,14 +486,27 @@ std::optional<double> certified_departure(const LinearWitness& witness, double n
 
 std::optional<Crossing> first_crossing(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample, double level,
                                        double t_begin, double t_end, const CrossingOptions& options) {
-  return search(Sampler(mode, sample, level), nullptr, t_begin, t_end, options);
+  return crossing_of(search(Sampler(mode, sample, level), nullptr, t_begin, t_end, options));
 }
 
 std::optional<Crossing> first_crossing_after_departure(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample,
                                                        double t0, double clear_until, double t_end,
                                                        const CrossingOptions& options) {
-  return search(Sampler(mode, sample, 0), nullptr, t0, t_end, options, clear_until);
+  return crossing_of(search(Sampler(mode, sample, 0), nullptr, t0, t_end, options, clear_until));
 }
+
+namespace detail {
+
+std::optional<TwoLevelCrossing> first_crossing_of_two_levels(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample,
+                                                             double level, double second_level, double second_from,
+                                                             double t_end, const CrossingOptions& options) {
+  const SecondLevel second{level - second_level, second_from};
+  const auto c = search(Sampler(mode, sample, level), nullptr, 0, t_end, options, -INFINITY, &second);
+  if (!c) return std::nullopt;
+  return TwoLevelCrossing{c->crossing, c->second};
+}
+
+}  // namespace detail
 
 std::optional<Crossing> first_crossing(const LinearWitness& witness, double t_begin, double t_end,
                                        const CrossingOptions& options) {
@@ -369,7 +515,7 @@ std::optional<Crossing> first_crossing(const LinearWitness& witness, double t_be
   const auto sample = [&witness](double t) { return sample_of(witness, t); };
   const std::function<double(double, double)>* bound =
       witness.third_derivative_bound ? &witness.third_derivative_bound : nullptr;
-  return search(Sampler(mode, sample, witness.level), bound, t_begin, t_end, options);
+  return crossing_of(search(Sampler(mode, sample, witness.level), bound, t_begin, t_end, options));
 }
 
 }  // namespace backlash::numeric

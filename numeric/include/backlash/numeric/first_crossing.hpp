@@ -8,27 +8,37 @@
 //   separation    w = Tc = JL·θ̈ + FL·θ̇         (contact mode)
 // Sampling alone cannot guarantee the first zero (a grazing approach or a
 // double crossing can hide between two samples, the failure of scipy's
-// solve_ivp), so the search is certified.  With z = x' (which obeys z' = A z,
-// so ‖z(t)‖∞ ≤ e^{‖A‖∞(t−a)}‖z(a)‖∞), on [a, b] (h = b − a) it bounds
-//   |w'''| = |eᵀA²z| ≤ ‖eᵀA²‖₁ e^{‖A‖h} ‖z(a)‖∞,
-// (with μ∞(A), the logarithmic norm, in place of ‖A‖∞ where it is smaller: a fast decaying
-// mode does not shrink the intervals), then |w''| ≤ M2 and |w'| ≤ M1 on [a, b] from the end
-// values, and
-//   – excludes the interval when w(a), w(b) have one sign and |w(a)| + |w(b)| > h·M1;
+// solve_ivp), so the search is certified.  Each sample gives w, w' = eᵀA x + eᵀc and
+// w'' = eᵀA² x + eᵀA c from one closed-form evaluation.  With z = x' (which obeys z' = A z, so
+// ‖D z(t)‖∞ ≤ e^{μ(t−a)}‖D z(a)‖∞, μ the logarithmic norm μ∞(D A D⁻¹) of the balanced A: a fast
+// decaying mode does not shrink the intervals), on [a, b] (h = b − a) it bounds
+//   |w'''| = |eᵀA²z| ≤ M3 = ‖eᵀA²D⁻¹‖₁ E(μ⁺h) ‖D z(a)‖∞,   E(x) ≥ e^x (an upper bound, no exp),
+// then |w''| ≤ M2 and |w'| ≤ M1 on [a, b] from the end values, and
+//   – excludes the interval when w(a), w(b) have one sign and either |w(a)| + |w(b)| > h·M1
+//     (mean value), or, by Taylor's theorem from each end over its half, the quadratics
+//     w(a) + w'(a)s + w''(a)s²/2 and w(b) − w'(b)s + w''(b)s²/2 (s ∈ [0, h/2]) keep that sign
+//     clear of the remainder M3 (h/2)³/6 (the curvature is used: an interval passes at about
+//     (|w|/M3)^{1/3});
 //   – accepts it as monotone when w'(a), w'(b) have one sign and (|w'(a)| + |w'(b)| − h·M2)/2 > 0,
-//     and then finds its single root (if w changes sign) with Boost.Math's toms748;
+//     or the lines w'(a) + w''(a)s and w'(b) − w''(b)s keep it clear of M3 (h/2)²/2; its single
+//     root (if w changes sign) is then polished by Halley's iteration on w, w', w'' inside the
+//     bracket (bisection when a step leaves it), to a step whose cubic error bound
+//     ((w''/2w')² + M3/(6|w'|))·|δ|³ is below a quarter of time_tolerance;
 //   – otherwise bisects, always examining the left half first.
-// An interval that can be neither excluded nor certified down to `min_interval`
-// is a grazing contact (w touches the level): it is reported as such.
+// Each test is a bound on w over the whole interval, so an interval passed over holds no zero and
+// the first root found is the first root: the certificate does not depend on where the samples
+// fall.  An interval that can be neither excluded nor certified down to `min_interval` is a
+// grazing contact (w touches the level): it is reported as such.
 //
-// Cost (docs/design.md, "The event loop"): the mode's constants (eᵀA, eᵀA², μ∞, the balancing D)
-// are a WitnessMode, built once per mode and parameter set; a search samples the closed form once
-// per point (WitnessSample: the state and the witness's value together); the bisection's stack is
-// inline; and an interval too long for either test to pass — decided from its left end alone,
-// with the bounds above — is halved without sampling its right end.  The intervals examined, their
-// order and every sample taken are those of the plain search (so every crossing is bit for bit
-// the same); only the samples that could not change a decision are left out, so a search's cost
-// does not grow with t_end − t_begin beyond a few flops per halving.
+// Cost (docs/design.md, "The event loop"): the mode's constants (eᵀA, eᵀA², μ∞, the balancing D,
+// the first window) are a WitnessMode, built once per mode and parameter set; a search samples the
+// closed form once per point (WitnessSample: the state and the witness's value together); the
+// bisection's stack is inline.  The search runs over windows: the first has the mode's own time
+// scale (WitnessMode::first_window, 4 over the mode's fastest rate), each later one twice the one
+// before, so an event costs what the mode's time scale asks, whatever t_end − t_begin is; an
+// interval too long for either test to pass — decided from its left end alone, with the bounds
+// above — is halved without sampling its right end.  Event times agree with the earlier TOMS 748
+// search (which stopped at a bracket of time_tolerance) to within that tolerance.
 #pragma once
 
 #include <Eigen/Dense>
@@ -104,6 +114,7 @@ struct WitnessMode {
   double norm_e_plain, norm_eA, norm_A;  ///< ‖eᵀ‖₁, ‖eᵀA‖₁, ‖D A‖∞ (rounding scales)
   double inverse_scale;  ///< max 1/D_i
   double time_unit;  ///< as LinearWitness::time_unit
+  double first_window;  ///< the length of a search's first window (the mode's time scale), s
 };
 
 struct Crossing {
@@ -113,7 +124,7 @@ struct Crossing {
 };
 
 struct CrossingOptions {
-  double time_tolerance = 1e-14;  ///< toms748 stopping width, relative to max(t, time_unit)
+  double time_tolerance = 1e-14;  ///< the root's tolerance (Halley's last step), relative to max(t, time_unit)
   double min_interval = 1e-11;    ///< in time units: below this an uncertified interval is a grazing contact
   long max_intervals = 2'000'000; ///< guard: then SearchBudgetExhausted (never a hang)
 };
@@ -141,7 +152,7 @@ std::optional<Crossing> first_crossing(const LinearWitness& witness, double t_be
 
 /// The same search on a mode built once: `sample(t)` gives x(t) and w(t) + `level` together
 /// (one closed-form evaluation per point).  Same answers, bit for bit, as the LinearWitness form
-/// with state = x and value = w + level.
+/// with state = x and value = w + level (and no third_derivative_bound).
 std::optional<Crossing> first_crossing(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample, double level,
                                        double t_begin, double t_end, const CrossingOptions& options = {});
 
@@ -156,9 +167,8 @@ std::optional<double> certified_departure(const WitnessMode& mode, const SmallVe
 double certified_clearance(const WitnessMode& mode, const SmallVector& x0, double t0, double noise);
 
 /// The search from a certified departure t0 with w ≠ 0 known on [t0, clear_until]
-/// (certified_clearance): the same answer as first_crossing(mode, sample, 0, t0, t_end) —
-/// the same intervals beyond clear_until, and the same crossing bit for bit — without sampling
-/// the intervals that end by clear_until (the subtree the plain search spends excluding them).
+/// (certified_clearance): the first zero in (t0, t_end], searched from clear_until (w has none
+/// before it).
 std::optional<Crossing> first_crossing_after_departure(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample,
                                                        double t0, double clear_until, double t_end,
                                                        const CrossingOptions& options = {});
