@@ -3,7 +3,10 @@
 # Chromium (issue 20; bench/README.md).  Not a test: it prints frames/s and where a redraw's
 # time goes, the time of a 60 s trajectory, and the machine's load (other work on the machine
 # slows the page).  BASELINE_PAGE: another build's page (e.g. main's), measured in the same run.
-#   bench/explorer_redraw.sh [BUILD_DIR] [FRAMES] [PARAMETER] [BASELINE_PAGE]
+#   bench/explorer_redraw.sh [BUILD_DIR] [FRAMES] [PARAMETER|P1,P2,…|all] [BASELINE_PAGE]
+# PARAMETER: a slider by its field's name (Jm, Fm, JL, FL, K, backlash or b, reference or θR, step,
+# t_end, an effect's parameter), or all (parameters, effects): every slider of the page (its parameter
+# fields', its effects'), one table each and a slider × case summary (explorer_redraw.mjs).
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 build=${1:-$here/../build}

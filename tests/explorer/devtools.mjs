@@ -83,18 +83,19 @@ export async function openBrowser(chromium) {
 /// The explorer page's own drag of a parameter's slider, as a user's: each animation frame
 /// moves the slider (an input event), the page redraws on its next frame.  `frames` redraws;
 /// returns the frames per second and the page's mean timings per redraw.  The slider is left
-/// where it is, still "sliding" (the caller releases it: releaseExpression).
-export function dragExpression(name, frames) {
+/// where it is, still "sliding" (the caller releases it: releaseExpression).  With `seconds`, the
+/// drag ends early when it has taken that long (cut: the frames moved).
+export function dragExpression(name, frames, seconds = Infinity) {
   return `new Promise((done) => {
     const e = window.explorer, slider = document.getElementById("s_${name}"), v0 = Number(slider.value);
     const sums = {}; let i = 0, t0 = 0, first = e.redraws;
     const tick = () => {
       if (e.redraws > first) for (const [k, v] of Object.entries(e.timings)) sums[k] = (sums[k] || 0) + v;
       if (i === 0) t0 = performance.now();
-      if (i === ${frames}) {
+      if (i === ${frames} || (i > 0 && performance.now() - t0 > ${seconds} * 1000)) {
         const seconds = (performance.now() - t0) / 1000, n = e.redraws - first;
         for (const k in sums) sums[k] /= n;
-        return done({ fps: n / seconds, redraws: n, ...sums });
+        return done({ fps: n / seconds, redraws: n, ...(i < ${frames} ? { cut: i } : {}), ...sums });
       }
       i++;
       slider.value = v0 * (1 + 0.3 * Math.sin(i / 6)) + 0.001 * Math.sin(i / 6); slider.dispatchEvent(new Event("input"));
