@@ -58,14 +58,24 @@ async function drag(id, name, values) {
       run: t && { start: t.start, t_end: t.t_end, events: t.simulation.events } }; })()`);
 }
 
-/// Every key of the CLI's document equal in the page's: numbers to 1e-12 relative, the rest exactly.
+/// A value of the page equal to the CLI's: numbers to 1e-12 relative, arrays and objects member
+/// by member at any depth (the page's WebAssembly libm may differ in a last bit), the rest exactly.
+function sameValue(p, v) {
+  if (typeof v === "number" && typeof p === "number") return close(p, v);
+  if (Array.isArray(v)) return Array.isArray(p) && p.length === v.length && v.every((x, i) => sameValue(p[i], x));
+  if (v !== null && typeof v === "object")
+    return p !== null && typeof p === "object" && Object.keys(p).length === Object.keys(v).length &&
+      Object.entries(v).every(([k, x]) => sameValue(p[k], x));
+  return p === v;
+}
+
+/// Every key of the CLI's document equal in the page's (sameValue).
 function sameDocument(page, cli, skip) {
   const differ = [];
   for (const [k, v] of Object.entries(cli)) {
     if (skip.includes(k)) continue;
     const p = page[k];
-    const ok = typeof v === "number" && typeof p === "number" ? close(p, v) : JSON.stringify(p) === JSON.stringify(v);
-    if (!ok) differ.push(`${k}: page ${JSON.stringify(p)}, CLI ${JSON.stringify(v)}`);
+    if (!sameValue(p, v)) differ.push(`${k}: page ${JSON.stringify(p)}, CLI ${JSON.stringify(v)}`);
   }
   return differ;
 }
