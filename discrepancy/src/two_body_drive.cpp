@@ -40,6 +40,7 @@ void filter_signals(Signals& s, const measurements::ButterworthLowPass& filter, 
   std::vector<double> held(n);
   for (std::size_t k = 0; k < n; ++k) held[k] = 0.5 * (s.u[k] + s.u[k == 0 ? 0 : k - 1]);  // the zero-order hold's average
   s.Uf = measurements::zero_phase_filter(held, s.filter);
+  s.uh = std::move(held);
 }
 
 namespace {
@@ -299,11 +300,71 @@ void gap_sigma(const std::vector<double>& xf, const std::vector<double>& R, GapF
 namespace {
 
 // The load side the observer reconstructs for gap b and the load's parameters in m.
+// The acceleration the motor would have alone, (u + T0 − Fm·v̂m − Tm·sgn v̂m)/Jm, from the held drive
+// itself (unfiltered): in rigid contact the mesh torque on the load is
+//   R = JL·Jm/(Jm + JL)·(a_alone + (FL·v + TL·sgn v)/JL),
+// so the load leaves its face exactly where the motor alone would brake harder than the load's own
+// friction brakes it — read on the logged drive at each sample, not on the filtered acceleration
+// (whose impulse response smears the separation over the filter's length: the backlash came out
+// up to 6 % off, docs/discrepancy.md).
+std::vector<double> motor_alone_acceleration(const Signals& s, const std::vector<double>& v, const Theta& m) {
+  std::vector<double> a(s.size());
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    const double sign = s.vm[k] > 0 ? 1 : s.vm[k] < 0 ? -1 : 0;
+    a[k] = (s.u[k] + m[kT0] - m[kFm] * v[k] - m[kTm] * sign) / m[kJm];
+  }
+  return a;
+}
+
+// The motor's velocity from the encoder's counts up to each sample (the slope at its end of the
+// least-squares parabola through the last 12): the load leaves the motor with the motor's
+// velocity at that instant, and the zero-phase filter's v̂m there already feels the motor's own
+// sharper braking after it.
+std::vector<double> causal_velocity(const Signals& s) {
+  constexpr int m = 12;
+  // The end-slope weights of a least-squares parabola over t = −(m−1)..0 samples.
+  static const std::array<double, m> w = [] {
+    Eigen::Matrix<double, m, 3> A;
+    for (int i = 0; i < m; ++i) A(i, 0) = 1, A(i, 1) = i - (m - 1), A(i, 2) = std::pow(i - (m - 1), 2);
+    const Eigen::Matrix<double, 3, m> pinv = (A.transpose() * A).inverse() * A.transpose();
+    std::array<double, m> out{};
+    for (int i = 0; i < m; ++i) out[static_cast<std::size_t>(i)] = pinv(1, i);
+    return out;
+  }();
+  std::vector<double> v = s.vm;
+  for (std::size_t k = m - 1; k < s.size(); ++k) {
+    double sum = 0;
+    for (int i = 0; i < m; ++i) sum += w[static_cast<std::size_t>(i)] * s.qm[k - (m - 1) + static_cast<std::size_t>(i)];
+    v[k] = sum * s.fs;
+  }
+  return v;
+}
+
+// The observer on the raw motor encoder (the impacts where its counts meet the coasting load) with
+// the separations from the drive (motor_alone_acceleration); `compliance` (1/kc, per unit load
+// inertia when JL = 1) times Jm/(Jm + JL) turns the observer's push into R/kc.
+std::vector<double> observe(const Signals& s, const Theta& m, double b, double JL, double FL, double TL, double compliance) {
+  const double share = m[kJm] / (m[kJm] + m[kJL]);
+  const std::vector<double> v = causal_velocity(s);
+  return load_observer(s.qm, v, motor_alone_acceleration(s, v, m), s.fs, b, 0, JL, FL, TL, compliance * share);
+}
+
 LoadSide observed_load(const Signals& s, double b, const Theta& m, double compliance) {
-  const std::vector<double> x = load_observer(s.qmf, s.vm, s.am, s.fs, b, 0, m[kJL], m[kFL], m[kTL], compliance);
+  const std::vector<double> x = observe(s, m, b, m[kJL], m[kFL], m[kTL], compliance);
   std::vector<double> qL(s.size());
   for (std::size_t k = 0; k < s.size(); ++k) qL[k] = s.qm[k] + x[k];
   return load_side(s, std::move(qL), false);
+}
+
+// With the motor encoder alone, where the load sits in the gap at the record's start is unknown
+// (the observer assumes a face); once the motor has gone half its whole travel — the widest gap
+// the shape's grid tries — from where it started, the load is on a face whatever gap it had.
+// The samples before that are left out of the comparison.
+std::size_t settled_from(const Signals& s) {
+  const auto [lo, hi] = std::minmax_element(s.qm.begin(), s.qm.end());
+  std::size_t k = 0;
+  while (k < s.size() && std::fabs(s.qm[k] - s.qm[0]) < 0.5 * (*hi - *lo)) ++k;
+  return k;
 }
 
 // The samples compared on a drive with a gap: the reversals stay in (the gap shows there, and
@@ -325,6 +386,8 @@ std::vector<std::size_t> observer_samples(const Signals& s, const std::vector<do
   };
   leave_out_rests(s.vm);
   if (vL) leave_out_rests(*vL);
+  else  // the motor encoder alone: where the load starts in its gap is unknown
+    for (std::size_t k = 0; k < settled_from(s); ++k) in[k] = 0;
   std::vector<std::size_t> out;
   for (std::size_t i = 0; i < n; ++i)
     if (in[i]) out.push_back(i);
@@ -339,8 +402,8 @@ struct Shape {
   double compliance = 0;  // 1/kc per unit load inertia (JL/kc: the observer runs with JL = 1); the file's, held
 };
 
-LoadSide tied_load(const Signals& s, const Shape& z) {
-  const std::vector<double> x = load_observer(s.qmf, s.vm, s.am, s.fs, z.b, 0, 1, z.alpha, z.beta, z.compliance);
+LoadSide tied_load(const Signals& s, const Shape& z, const Theta& m) {
+  const std::vector<double> x = observe(s, m, z.b, 1, z.alpha, z.beta, z.compliance);
   std::vector<double> qL(s.size());
   for (std::size_t k = 0; k < s.size(); ++k) qL[k] = s.qm[k] + x[k];
   LoadSide l = load_side(s, std::move(qL), false);
@@ -352,7 +415,7 @@ LinearFit shape_fit(const Signals& s, const Shape& z, const Theta& start, FreeSe
   Theta m = start;
   m[kFL] = m[kTL] = 0;
   free[kJL] = true, free[kFL] = free[kTL] = false;
-  LinearFit f = solve(s, tied_load(s, z), m, free, samples);
+  LinearFit f = solve(s, tied_load(s, z, m), m, free, samples);
   if (f.ok) f.m[kFL] = z.alpha * f.m[kJL], f.m[kTL] = z.beta * f.m[kJL];
   return f;
 }
@@ -451,7 +514,7 @@ void polish_shape(const Signals& s, ObserverFit& f, const FreeSet& free, bool co
     const LinearFit l = shape_fit(s, z, start, free, samples);
     Theta m = l.m;
     m[kFL] = m[kTL] = 0;
-    const std::vector<double> all = l.ok ? residuals(s, tied_load(s, z), m) : std::vector<double>(s.size(), 1e3);
+    const std::vector<double> all = l.ok ? residuals(s, tied_load(s, z, m), m) : std::vector<double>(s.size(), 1e3);
     for (std::size_t i = 0; i < samples.size(); ++i) r[i] = all[samples[i]];
   };
   ceres_sigma(residual, samples.size(), x, std::vector<double>(x.size(), 0.0), true, 1e-3);
@@ -498,7 +561,7 @@ std::vector<double> observer_sigma(const Signals& s, ObserverFit& f, const FreeS
     const Shape z{std::max(0.0, p[0]), std::max(0.0, m[kFL]) / JL, std::max(0.0, m[kTL]) / JL, f.z.compliance};
     Theta mt = m;
     mt[kJL] = JL, mt[kFL] = mt[kTL] = 0;
-    const std::vector<double> all = residuals(s, tied_load(s, z), mt);
+    const std::vector<double> all = residuals(s, tied_load(s, z, mt), mt);
     for (std::size_t i = 0; i < samples.size(); ++i) r[i] = all[samples[i]];
   };
   std::vector<double> sigma = ceres_sigma(residual, samples.size(), x, std::vector<double>(x.size(), -INFINITY), false);
@@ -722,7 +785,7 @@ void motor_encoder(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   f.all = samples;
   two.torque_rms_rigid = std::sqrt(final_fit.sse_rigid / static_cast<double>(std::max<std::size_t>(1, samples.size())));
   two.contact_fraction = NAN;
-  const std::vector<double> model_gap = load_observer(s.qmf, s.vm, s.am, s.fs, f.b, 0, f.m[kJL], f.m[kFL], f.m[kTL], f.compliance);
+  const std::vector<double> model_gap = observe(s, f.m, f.b, f.m[kJL], f.m[kFL], f.m[kTL], f.compliance);
   two.reversals = lost_motion(s, nullptr, model_gap);
 }
 
