@@ -40,7 +40,6 @@ void filter_signals(Signals& s, const measurements::ButterworthLowPass& filter, 
   std::vector<double> held(n);
   for (std::size_t k = 0; k < n; ++k) held[k] = 0.5 * (s.u[k] + s.u[k == 0 ? 0 : k - 1]);  // the zero-order hold's average
   s.Uf = measurements::zero_phase_filter(held, s.filter);
-  s.uh = std::move(held);
 }
 
 namespace {
@@ -571,6 +570,75 @@ std::vector<double> observer_sigma(const Signals& s, ObserverFit& f, const FreeS
   return out;
 }
 
+// The blocks of the sandwich below: the record cut midway between the motor's reversals (in its
+// quiet cruise), so that each block holds one move's events (separation, flight, impact).
+std::vector<int> move_blocks(const Signals& s) {
+  std::vector<std::size_t> at;
+  int last = 0;
+  for (std::size_t k = s.begin; k < s.end; ++k) {
+    if (s.sm[k] == 0) continue;
+    if (last != 0 && s.sm[k] != last) at.push_back(k);
+    last = s.sm[k];
+  }
+  std::vector<int> block(s.size(), 0);
+  for (std::size_t i = 0; i + 1 < at.size(); ++i)
+    for (std::size_t k = (at[i] + at[i + 1]) / 2; k < s.size(); ++k) block[k] = static_cast<int>(i + 1);
+  return block;
+}
+
+// The argument of the minimum of a cost sampled at b_j = b_0 + j·h: the parabola through the
+// least sample and its neighbours (the grid's end when the least is there).
+double grid_minimum(const std::vector<double>& cost, double b0, double h) {
+  const std::size_t j = static_cast<std::size_t>(std::min_element(cost.begin(), cost.end()) - cost.begin());
+  if (j == 0 || j + 1 == cost.size()) return b0 + static_cast<double>(j) * h;
+  const double denominator = cost[j - 1] - 2 * cost[j] + cost[j + 1];
+  const double shift = denominator > 0 ? 0.5 * (cost[j - 1] - cost[j + 1]) / denominator : 0;
+  return b0 + (static_cast<double>(j) + shift) * h;
+}
+
+// σ of the backlash (motor encoder alone).  The profiled observer cost S(b) (the shape's α, β held,
+// the linear parameters projected out) is sharp — a wrong gap mistimes the impacts — and at its
+// minimum the residual stays above the noise: the observer's model error, not the noise, limits
+// the backlash, and it differs from move to move.  So σ is the jackknife over the moves (the
+// record cut midway between the motor's reversals): the gap minimising S less one move's share,
+// each move in turn, on a grid of 41 gaps over b ± 10 % (or ± 20 encoder counts when wider);
+// Var b = (G − 1)/G·Σ (b₋ᵢ − b̄)².  Never below the white-residual bound 2·σ_r²·τ_int / S''.
+double profile_sigma_b(const Signals& s, const ObserverFit& f, const FreeSet& free, const std::vector<std::size_t>& samples) {
+  double count = INFINITY;
+  for (std::size_t k = 1; k < s.size(); ++k)
+    if (s.qm[k] != s.qm[k - 1]) count = std::min(count, std::fabs(s.qm[k] - s.qm[k - 1]));
+  const double half = std::max(0.1 * f.z.b, std::isfinite(count) ? 20 * count : 0.1 * f.z.b);
+  const double b0 = std::max(0.0, f.z.b - half), h = (f.z.b + half - b0) / 40;
+  if (!(h > 0)) return NAN;
+  const std::vector<int> block = move_blocks(s);
+  const std::size_t blocks = static_cast<std::size_t>(block.back() + 1);
+  std::vector<double> total(41, 0.0);
+  std::vector<std::vector<double>> share(blocks, std::vector<double>(41, 0.0));
+  double variance = NAN, tau = 1;
+  for (std::size_t j = 0; j < 41; ++j) {
+    Shape z = f.z;
+    z.b = b0 + static_cast<double>(j) * h;
+    const LinearFit l = shape_fit(s, z, f.m, free, samples);
+    if (!l.ok) return NAN;
+    Theta m = l.m;
+    m[kFL] = m[kTL] = 0;
+    const std::vector<double> r = residuals(s, tied_load(s, z, m), m);
+    std::vector<double> inner;
+    for (std::size_t k : samples) share[static_cast<std::size_t>(block[k])][j] += r[k] * r[k], total[j] += r[k] * r[k], inner.push_back(r[k]);
+    if (j == 20) variance = total[j] / static_cast<double>(std::max<std::size_t>(2, samples.size()) - 1), tau = tau_int_or_one(inner);
+  }
+  const double curvature = (total[21] - 2 * total[20] + total[19]) / (h * h);
+  double white = curvature > 0 ? 2 * variance * tau / curvature : INFINITY, jack = 0, mean = 0;
+  std::vector<double> leave_out(blocks);
+  for (std::size_t i = 0; i < blocks; ++i) {
+    std::vector<double> cost(41);
+    for (std::size_t j = 0; j < 41; ++j) cost[j] = total[j] - share[i][j];
+    leave_out[i] = grid_minimum(cost, b0, h), mean += leave_out[i] / static_cast<double>(blocks);
+  }
+  for (double b : leave_out) jack += (b - mean) * (b - mean) * static_cast<double>(blocks - 1) / static_cast<double>(blocks);
+  return std::sqrt(std::max(white, jack));
+}
+
 }  // namespace
 
 // ------------------------------------------------------------------ the result
@@ -772,7 +840,7 @@ void motor_encoder(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   final_fit.m = f.nominal;
   fit_shape(s, final_fit, f.free, coulomb_load, false, samples);
   f.sigma = observer_sigma(s, final_fit, f.free, coulomb_load, samples);
-  f.m = final_fit.m, f.b = final_fit.z.b, f.sigma_b = final_fit.sigma_b;
+  f.m = final_fit.m, f.b = final_fit.z.b, f.sigma_b = profile_sigma_b(s, final_fit, f.free, samples);
   // The load's parameters untied from the shape: least squares of the summed equation on the
   // load the fitted shape observes (in contact the load's viscous friction is the total less the
   // motor's; the shape's α = FL/JL only governs the brief flights).

@@ -28,7 +28,6 @@ struct Signals {
   double fs = 0;
   std::vector<double> t, qm, qL, u;        ///< as logged (u = gain·drive); qL empty: motor encoder alone
   std::vector<double> qmf, vm, am, Uf;     ///< filtered; Uf the held drive, filtered
-  std::vector<double> uh;                  ///< the held drive at each sample (the hold's average), unfiltered
   std::vector<double> sm_f;                ///< filtered sgn v̂m
   std::vector<signed char> sm;             ///< sgn v̂m, 0 at rest
   std::size_t begin = 0, end = 0;          ///< the filter's end transients left out
