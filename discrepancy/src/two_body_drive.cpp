@@ -639,6 +639,41 @@ double profile_sigma_b(const Signals& s, const ObserverFit& f, const FreeSet& fr
   return std::sqrt(std::max(white, jack));
 }
 
+// The part of σ_b the jackknife cannot see (motor encoder alone): the observer places each
+// separation and each impact on a sample, so every reversal's lost motion is off by what the gap
+// moves in a fraction of a sample — the same way at every reversal, a bias no scatter over the
+// moves shows.  Each event taken as uniform over one sample (σ = T/√12 in time): an impact
+// mistimed by δt moves the gap by ẋ·δt (ẋ its rate just before the face); a separation mistimed
+// by δt gives the load the motor's velocity off by ẍ·δt, which the flight (of length t_f) turns
+// into ẍ·δt·t_f at the face.  σ = √(mean over the flights of (ẋ·T)² + (ẍ·T·t_f)²)/√12, not
+// divided by √(flights): the bias is shared.
+double timing_sigma_b(const std::vector<double>& gap, double b, std::size_t from, std::size_t to) {
+  double sum = 0;
+  std::size_t flights = 0;
+  auto on_face = [&](std::size_t k) { return std::fabs(std::fabs(gap[k]) - b / 2) <= 1e-9 * std::max(b, 1e-300); };
+  for (std::size_t k = std::max<std::size_t>(from, 2); k + 1 < to; ++k) {
+    if (!(on_face(k - 1) && !on_face(k))) continue;  // a separation at k
+    std::size_t e = k;
+    while (e < to && !on_face(e)) ++e;
+    if (e >= to || e < k + 2) continue;
+    // ẋ and ẍ from the parabola through the flight's samples (the gap is read on the motor's
+    // counts: a difference of samples would be the quantisation's).
+    const std::size_t m = e - k + 1;
+    Eigen::MatrixXd A(m, 3);
+    Eigen::VectorXd y(m);
+    for (std::size_t i = 0; i < m; ++i) {
+      const double tau = static_cast<double>(i);
+      A(i, 0) = 1, A(i, 1) = tau, A(i, 2) = tau * tau, y(i) = gap[k - 1 + i];
+    }
+    const Eigen::Vector3d c = A.colPivHouseholderQr().solve(y);
+    const double rate = std::fabs(c(1) + 2 * c(2) * static_cast<double>(m - 1));  // ẋ·T at the face
+    const double bend = std::fabs(2 * c(2)) * static_cast<double>(m - 1);          // ẍ·T·t_f
+    sum += rate * rate + bend * bend, ++flights;
+    k = e;
+  }
+  return flights > 0 ? std::sqrt(sum / static_cast<double>(flights) / 12) : 0;
+}
+
 }  // namespace
 
 // ------------------------------------------------------------------ the result
@@ -669,17 +704,25 @@ std::vector<LostMotion> lost_motion(const Signals& s, const std::vector<double>*
     last = s.sm[k];
   }
   std::vector<LostMotion> out;
-  auto swing = [](const std::vector<double>& x, std::size_t a, std::size_t b) {
-    const auto [lo, hi] = std::minmax_element(x.begin() + static_cast<std::ptrdiff_t>(a), x.begin() + static_cast<std::ptrdiff_t>(b));
-    return *hi - *lo;
+  // The face either side: the median of the gap from the midpoint to the reversal and from the
+  // reversal to the next midpoint (the gap sits on a face most of each half; a max − min swing
+  // would add the encoders' quantisation, two counts or more, and the filter's overshoot).
+  auto median = [](const std::vector<double>& x, std::size_t a, std::size_t b) -> double {
+    std::vector<double> v(x.begin() + static_cast<std::ptrdiff_t>(a), x.begin() + static_cast<std::ptrdiff_t>(b));
+    if (v.empty()) return NAN;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  auto swing = [&](const std::vector<double>& x, std::size_t a, std::size_t b, std::size_t at) {
+    return std::fabs(median(x, at, b) - median(x, a, at));
   };
   for (std::size_t i = 0; i < at.size(); ++i) {
     const std::size_t a = i == 0 ? s.begin : (at[i - 1] + at[i]) / 2;
     const std::size_t b = i + 1 == at.size() ? s.end : (at[i] + at[i + 1]) / 2;
     LostMotion l;
     l.t = s.t[at[i]], l.direction = direction[i];
-    if (measured_gap) l.measured = swing(*measured_gap, a, b);
-    l.model = swing(model_gap, a, b);
+    if (measured_gap) l.measured = swing(*measured_gap, a, b, at[i]);
+    l.model = swing(model_gap, a, b, at[i]);
     out.push_back(l);
   }
   return out;
@@ -752,6 +795,7 @@ FlightFit load_coulomb_in_flight(const Signals& s, const LoadSide& l, const std:
   if (!flight.ok) return flight;
   Candidate c;
   c.effect = "coulomb_load";
+  c.rms = c.rms_fit = c.rms_holdout = NAN;  // judged on the load's flights (positions), not on the torque
   c.parameters = {{"torque", flight.beta * current[kJL], flight.sigma * current[kJL]}};
   c.delta_bic = flight.delta_bic;
   c.at_range_edge = !(flight.beta > 0);
@@ -797,6 +841,7 @@ void both_encoders(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   const double n_eff = static_cast<double>(rigid.contact.size()) / tau_int_on(xf, rigid.contact);
   Candidate c;
   c.effect = "compliance";
+  c.rms = c.rms_fit = c.rms_holdout = NAN;  // judged on the gap's faces (positions), not on the torque
   if (std::isfinite(compliant.sse) && compliant.contact.size() > 10) {
     c.delta_bic = n_eff * std::log(std::max(compliant.sse, 1e-300) / std::max(rigid.sse, 1e-300)) + 2 * std::log(n_eff);  // 1/kc and cm/kc
     c.at_range_edge = !(compliant.c > 0);
@@ -813,7 +858,9 @@ void both_encoders(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   two.gap_offset = g.x0, two.contact_fraction = g.contact_fraction;
   std::vector<double> model_gap = load_observer(s.qmf, s.vm, s.am, s.fs, g.b, g.x0, f.m[kJL], f.m[kFL], f.m[kTL]);
   for (std::size_t k = 0; k < s.size(); ++k) model_gap[k] -= g.c * R[k];
-  two.reversals = lost_motion(s, &xf, model_gap);
+  // The model's lost motion as the measured one is read: the swing of the gap through the same
+  // filter (whose step response overshoots at each impact: the swing exceeds b by as much).
+  two.reversals = lost_motion(s, &xf, measurements::zero_phase_filter(model_gap, s.filter));
   two.loop_motor = s.qm, two.loop_load = s.qL, two.loop_model.resize(s.size());
   for (std::size_t k = 0; k < s.size(); ++k) two.loop_model[k] = s.qm[k] + model_gap[k];
 }
@@ -855,6 +902,9 @@ void motor_encoder(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   two.contact_fraction = NAN;
   const std::vector<double> model_gap = observe(s, f.m, f.b, f.m[kJL], f.m[kFL], f.m[kTL], f.compliance);
   two.reversals = lost_motion(s, nullptr, model_gap);
+  two.backlash_sigma_moves = f.sigma_b;
+  two.backlash_sigma_timing = timing_sigma_b(model_gap, f.b, samples.empty() ? s.begin : samples.front(), s.end);
+  f.sigma_b = std::hypot(f.sigma_b, two.backlash_sigma_timing);
 }
 
 }  // namespace
@@ -880,9 +930,6 @@ Status status_of(const DriveDiscrepancyResult& r, const TwoBodyFindings& two) {
 void fill_result(const Signals& s, const Fitted& f, DriveDiscrepancyResult& r) {
   r.rms_given = rms_on(f.r_given, f.all), r.rms_before = rms_on(f.r_nominal, f.all), r.rms_after = rms_on(f.r_after, f.all);
   r.tau_int_before = tau_int_on(f.r_nominal, f.all), r.tau_int_after = tau_int_on(f.r_after, f.all);
-  std::vector<double> inner;
-  for (std::size_t k : f.all) inner.push_back(f.r_after[k]);
-  r.noise = estimate_noise(inner);
   for (Candidate& c : r.effects) {
     const auto it = std::find_if(effect_columns().begin(), effect_columns().end(), [&](const auto& e) { return e.first == c.effect; });
     if (it != effect_columns().end()) c.parameters = {{"torque", f.m[it->second], f.sigma[static_cast<std::size_t>(it->second)]}};
@@ -927,6 +974,10 @@ DriveDiscrepancyResult find(const model::CaseSpec& spec, const measurements::Mea
                                 " times: with the motor encoder alone the backlash needs at least 5 reversals (or log theta_load)");
   two.rigid = !(f.b > 3 * f.sigma_b);
   fill_result(s, f, result);
+  // The noise level: the encoders' quantisation and the drive's noise propagated (not the Δ⁴
+  // rule on the residual, which is filtered: far below its noise).
+  two.noise = noise_level(s, f.m);
+  result.noise = two.noise.level, result.position_noise = two.noise.sigma_motor, result.drive_noise = two.noise.sigma_drive;
   result.given = given;
   result.nominal = result.parameters = given;
   result.nominal.JL = f.nominal[kJL], result.nominal.FL = f.nominal[kFL], result.nominal.Jm = f.nominal[kJm], result.nominal.Fm = f.nominal[kFm];
