@@ -299,11 +299,71 @@ void gap_sigma(const std::vector<double>& xf, const std::vector<double>& R, GapF
 namespace {
 
 // The load side the observer reconstructs for gap b and the load's parameters in m.
+// The acceleration the motor would have alone, (u + T0 − Fm·v̂m − Tm·sgn v̂m)/Jm, from the held drive
+// itself (unfiltered): in rigid contact the mesh torque on the load is
+//   R = JL·Jm/(Jm + JL)·(a_alone + (FL·v + TL·sgn v)/JL),
+// so the load leaves its face exactly where the motor alone would brake harder than the load's own
+// friction brakes it — read on the logged drive at each sample, not on the filtered acceleration
+// (whose impulse response smears the separation over the filter's length: the backlash came out
+// up to 6 % off, docs/discrepancy.md).
+std::vector<double> motor_alone_acceleration(const Signals& s, const std::vector<double>& v, const Theta& m) {
+  std::vector<double> a(s.size());
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    const double sign = s.vm[k] > 0 ? 1 : s.vm[k] < 0 ? -1 : 0;
+    a[k] = (s.u[k] + m[kT0] - m[kFm] * v[k] - m[kTm] * sign) / m[kJm];
+  }
+  return a;
+}
+
+// The motor's velocity from the encoder's counts up to each sample (the slope at its end of the
+// least-squares parabola through the last 12): the load leaves the motor with the motor's
+// velocity at that instant, and the zero-phase filter's v̂m there already feels the motor's own
+// sharper braking after it.
+std::vector<double> causal_velocity(const Signals& s) {
+  constexpr int m = 12;
+  // The end-slope weights of a least-squares parabola over t = −(m−1)..0 samples.
+  static const std::array<double, m> w = [] {
+    Eigen::Matrix<double, m, 3> A;
+    for (int i = 0; i < m; ++i) A(i, 0) = 1, A(i, 1) = i - (m - 1), A(i, 2) = std::pow(i - (m - 1), 2);
+    const Eigen::Matrix<double, 3, m> pinv = (A.transpose() * A).inverse() * A.transpose();
+    std::array<double, m> out{};
+    for (int i = 0; i < m; ++i) out[static_cast<std::size_t>(i)] = pinv(1, i);
+    return out;
+  }();
+  std::vector<double> v = s.vm;
+  for (std::size_t k = m - 1; k < s.size(); ++k) {
+    double sum = 0;
+    for (int i = 0; i < m; ++i) sum += w[static_cast<std::size_t>(i)] * s.qm[k - (m - 1) + static_cast<std::size_t>(i)];
+    v[k] = sum * s.fs;
+  }
+  return v;
+}
+
+// The observer on the raw motor encoder (the impacts where its counts meet the coasting load) with
+// the separations from the drive (motor_alone_acceleration); `compliance` (1/kc, per unit load
+// inertia when JL = 1) times Jm/(Jm + JL) turns the observer's push into R/kc.
+std::vector<double> observe(const Signals& s, const Theta& m, double b, double JL, double FL, double TL, double compliance) {
+  const double share = m[kJm] / (m[kJm] + m[kJL]);
+  const std::vector<double> v = causal_velocity(s);
+  return load_observer(s.qm, v, motor_alone_acceleration(s, v, m), s.fs, b, 0, JL, FL, TL, compliance * share);
+}
+
 LoadSide observed_load(const Signals& s, double b, const Theta& m, double compliance) {
-  const std::vector<double> x = load_observer(s.qmf, s.vm, s.am, s.fs, b, 0, m[kJL], m[kFL], m[kTL], compliance);
+  const std::vector<double> x = observe(s, m, b, m[kJL], m[kFL], m[kTL], compliance);
   std::vector<double> qL(s.size());
   for (std::size_t k = 0; k < s.size(); ++k) qL[k] = s.qm[k] + x[k];
   return load_side(s, std::move(qL), false);
+}
+
+// With the motor encoder alone, where the load sits in the gap at the record's start is unknown
+// (the observer assumes a face); once the motor has gone half its whole travel — the widest gap
+// the shape's grid tries — from where it started, the load is on a face whatever gap it had.
+// The samples before that are left out of the comparison.
+std::size_t settled_from(const Signals& s) {
+  const auto [lo, hi] = std::minmax_element(s.qm.begin(), s.qm.end());
+  std::size_t k = 0;
+  while (k < s.size() && std::fabs(s.qm[k] - s.qm[0]) < 0.5 * (*hi - *lo)) ++k;
+  return k;
 }
 
 // The samples compared on a drive with a gap: the reversals stay in (the gap shows there, and
@@ -325,6 +385,8 @@ std::vector<std::size_t> observer_samples(const Signals& s, const std::vector<do
   };
   leave_out_rests(s.vm);
   if (vL) leave_out_rests(*vL);
+  else  // the motor encoder alone: where the load starts in its gap is unknown
+    for (std::size_t k = 0; k < settled_from(s); ++k) in[k] = 0;
   std::vector<std::size_t> out;
   for (std::size_t i = 0; i < n; ++i)
     if (in[i]) out.push_back(i);
@@ -339,8 +401,8 @@ struct Shape {
   double compliance = 0;  // 1/kc per unit load inertia (JL/kc: the observer runs with JL = 1); the file's, held
 };
 
-LoadSide tied_load(const Signals& s, const Shape& z) {
-  const std::vector<double> x = load_observer(s.qmf, s.vm, s.am, s.fs, z.b, 0, 1, z.alpha, z.beta, z.compliance);
+LoadSide tied_load(const Signals& s, const Shape& z, const Theta& m) {
+  const std::vector<double> x = observe(s, m, z.b, 1, z.alpha, z.beta, z.compliance);
   std::vector<double> qL(s.size());
   for (std::size_t k = 0; k < s.size(); ++k) qL[k] = s.qm[k] + x[k];
   LoadSide l = load_side(s, std::move(qL), false);
@@ -352,7 +414,7 @@ LinearFit shape_fit(const Signals& s, const Shape& z, const Theta& start, FreeSe
   Theta m = start;
   m[kFL] = m[kTL] = 0;
   free[kJL] = true, free[kFL] = free[kTL] = false;
-  LinearFit f = solve(s, tied_load(s, z), m, free, samples);
+  LinearFit f = solve(s, tied_load(s, z, m), m, free, samples);
   if (f.ok) f.m[kFL] = z.alpha * f.m[kJL], f.m[kTL] = z.beta * f.m[kJL];
   return f;
 }
@@ -451,7 +513,7 @@ void polish_shape(const Signals& s, ObserverFit& f, const FreeSet& free, bool co
     const LinearFit l = shape_fit(s, z, start, free, samples);
     Theta m = l.m;
     m[kFL] = m[kTL] = 0;
-    const std::vector<double> all = l.ok ? residuals(s, tied_load(s, z), m) : std::vector<double>(s.size(), 1e3);
+    const std::vector<double> all = l.ok ? residuals(s, tied_load(s, z, m), m) : std::vector<double>(s.size(), 1e3);
     for (std::size_t i = 0; i < samples.size(); ++i) r[i] = all[samples[i]];
   };
   ceres_sigma(residual, samples.size(), x, std::vector<double>(x.size(), 0.0), true, 1e-3);
@@ -498,7 +560,7 @@ std::vector<double> observer_sigma(const Signals& s, ObserverFit& f, const FreeS
     const Shape z{std::max(0.0, p[0]), std::max(0.0, m[kFL]) / JL, std::max(0.0, m[kTL]) / JL, f.z.compliance};
     Theta mt = m;
     mt[kJL] = JL, mt[kFL] = mt[kTL] = 0;
-    const std::vector<double> all = residuals(s, tied_load(s, z), mt);
+    const std::vector<double> all = residuals(s, tied_load(s, z, mt), mt);
     for (std::size_t i = 0; i < samples.size(); ++i) r[i] = all[samples[i]];
   };
   std::vector<double> sigma = ceres_sigma(residual, samples.size(), x, std::vector<double>(x.size(), -INFINITY), false);
@@ -506,6 +568,110 @@ std::vector<double> observer_sigma(const Signals& s, ObserverFit& f, const FreeS
   std::vector<double> out(kCount, NAN);
   for (std::size_t j = 0; j < order.size(); ++j) out[static_cast<std::size_t>(order[j])] = sigma[j + 1];
   return out;
+}
+
+// The blocks of the sandwich below: the record cut midway between the motor's reversals (in its
+// quiet cruise), so that each block holds one move's events (separation, flight, impact).
+std::vector<int> move_blocks(const Signals& s) {
+  std::vector<std::size_t> at;
+  int last = 0;
+  for (std::size_t k = s.begin; k < s.end; ++k) {
+    if (s.sm[k] == 0) continue;
+    if (last != 0 && s.sm[k] != last) at.push_back(k);
+    last = s.sm[k];
+  }
+  std::vector<int> block(s.size(), 0);
+  for (std::size_t i = 0; i + 1 < at.size(); ++i)
+    for (std::size_t k = (at[i] + at[i + 1]) / 2; k < s.size(); ++k) block[k] = static_cast<int>(i + 1);
+  return block;
+}
+
+// The argument of the minimum of a cost sampled at b_j = b_0 + j·h: the parabola through the
+// least sample and its neighbours (the grid's end when the least is there).
+double grid_minimum(const std::vector<double>& cost, double b0, double h) {
+  const std::size_t j = static_cast<std::size_t>(std::min_element(cost.begin(), cost.end()) - cost.begin());
+  if (j == 0 || j + 1 == cost.size()) return b0 + static_cast<double>(j) * h;
+  const double denominator = cost[j - 1] - 2 * cost[j] + cost[j + 1];
+  const double shift = denominator > 0 ? 0.5 * (cost[j - 1] - cost[j + 1]) / denominator : 0;
+  return b0 + (static_cast<double>(j) + shift) * h;
+}
+
+// σ of the backlash (motor encoder alone).  The profiled observer cost S(b) (the shape's α, β held,
+// the linear parameters projected out) is sharp — a wrong gap mistimes the impacts — and at its
+// minimum the residual stays above the noise: the observer's model error, not the noise, limits
+// the backlash, and it differs from move to move.  So σ is the jackknife over the moves (the
+// record cut midway between the motor's reversals): the gap minimising S less one move's share,
+// each move in turn, on a grid of 41 gaps over b ± 10 % (or ± 20 encoder counts when wider);
+// Var b = (G − 1)/G·Σ (b₋ᵢ − b̄)².  Never below the white-residual bound 2·σ_r²·τ_int / S''.
+double profile_sigma_b(const Signals& s, const ObserverFit& f, const FreeSet& free, const std::vector<std::size_t>& samples) {
+  double count = INFINITY;
+  for (std::size_t k = 1; k < s.size(); ++k)
+    if (s.qm[k] != s.qm[k - 1]) count = std::min(count, std::fabs(s.qm[k] - s.qm[k - 1]));
+  const double half = std::max(0.1 * f.z.b, std::isfinite(count) ? 20 * count : 0.1 * f.z.b);
+  const double b0 = std::max(0.0, f.z.b - half), h = (f.z.b + half - b0) / 40;
+  if (!(h > 0)) return NAN;
+  const std::vector<int> block = move_blocks(s);
+  const std::size_t blocks = static_cast<std::size_t>(block.back() + 1);
+  std::vector<double> total(41, 0.0);
+  std::vector<std::vector<double>> share(blocks, std::vector<double>(41, 0.0));
+  double variance = NAN, tau = 1;
+  for (std::size_t j = 0; j < 41; ++j) {
+    Shape z = f.z;
+    z.b = b0 + static_cast<double>(j) * h;
+    const LinearFit l = shape_fit(s, z, f.m, free, samples);
+    if (!l.ok) return NAN;
+    Theta m = l.m;
+    m[kFL] = m[kTL] = 0;
+    const std::vector<double> r = residuals(s, tied_load(s, z, m), m);
+    std::vector<double> inner;
+    for (std::size_t k : samples) share[static_cast<std::size_t>(block[k])][j] += r[k] * r[k], total[j] += r[k] * r[k], inner.push_back(r[k]);
+    if (j == 20) variance = total[j] / static_cast<double>(std::max<std::size_t>(2, samples.size()) - 1), tau = tau_int_or_one(inner);
+  }
+  const double curvature = (total[21] - 2 * total[20] + total[19]) / (h * h);
+  double white = curvature > 0 ? 2 * variance * tau / curvature : INFINITY, jack = 0, mean = 0;
+  std::vector<double> leave_out(blocks);
+  for (std::size_t i = 0; i < blocks; ++i) {
+    std::vector<double> cost(41);
+    for (std::size_t j = 0; j < 41; ++j) cost[j] = total[j] - share[i][j];
+    leave_out[i] = grid_minimum(cost, b0, h), mean += leave_out[i] / static_cast<double>(blocks);
+  }
+  for (double b : leave_out) jack += (b - mean) * (b - mean) * static_cast<double>(blocks - 1) / static_cast<double>(blocks);
+  return std::sqrt(std::max(white, jack));
+}
+
+// The part of σ_b the jackknife cannot see (motor encoder alone): the observer places each
+// separation and each impact on a sample, so every reversal's lost motion is off by what the gap
+// moves in a fraction of a sample — the same way at every reversal, a bias no scatter over the
+// moves shows.  Each event taken as uniform over one sample (σ = T/√12 in time): an impact
+// mistimed by δt moves the gap by ẋ·δt (ẋ its rate just before the face); a separation mistimed
+// by δt gives the load the motor's velocity off by ẍ·δt, which the flight (of length t_f) turns
+// into ẍ·δt·t_f at the face.  σ = √(mean over the flights of (ẋ·T)² + (ẍ·T·t_f)²)/√12, not
+// divided by √(flights): the bias is shared.
+double timing_sigma_b(const std::vector<double>& gap, double b, std::size_t from, std::size_t to) {
+  double sum = 0;
+  std::size_t flights = 0;
+  auto on_face = [&](std::size_t k) { return std::fabs(std::fabs(gap[k]) - b / 2) <= 1e-9 * std::max(b, 1e-300); };
+  for (std::size_t k = std::max<std::size_t>(from, 2); k + 1 < to; ++k) {
+    if (!(on_face(k - 1) && !on_face(k))) continue;  // a separation at k
+    std::size_t e = k;
+    while (e < to && !on_face(e)) ++e;
+    if (e >= to || e < k + 2) continue;
+    // ẋ and ẍ from the parabola through the flight's samples (the gap is read on the motor's
+    // counts: a difference of samples would be the quantisation's).
+    const std::size_t m = e - k + 1;
+    Eigen::MatrixXd A(m, 3);
+    Eigen::VectorXd y(m);
+    for (std::size_t i = 0; i < m; ++i) {
+      const double tau = static_cast<double>(i);
+      A(i, 0) = 1, A(i, 1) = tau, A(i, 2) = tau * tau, y(i) = gap[k - 1 + i];
+    }
+    const Eigen::Vector3d c = A.colPivHouseholderQr().solve(y);
+    const double rate = std::fabs(c(1) + 2 * c(2) * static_cast<double>(m - 1));  // ẋ·T at the face
+    const double bend = std::fabs(2 * c(2)) * static_cast<double>(m - 1);          // ẍ·T·t_f
+    sum += rate * rate + bend * bend, ++flights;
+    k = e;
+  }
+  return flights > 0 ? std::sqrt(sum / static_cast<double>(flights) / 12) : 0;
 }
 
 }  // namespace
@@ -538,17 +704,25 @@ std::vector<LostMotion> lost_motion(const Signals& s, const std::vector<double>*
     last = s.sm[k];
   }
   std::vector<LostMotion> out;
-  auto swing = [](const std::vector<double>& x, std::size_t a, std::size_t b) {
-    const auto [lo, hi] = std::minmax_element(x.begin() + static_cast<std::ptrdiff_t>(a), x.begin() + static_cast<std::ptrdiff_t>(b));
-    return *hi - *lo;
+  // The face either side: the median of the gap from the midpoint to the reversal and from the
+  // reversal to the next midpoint (the gap sits on a face most of each half; a max − min swing
+  // would add the encoders' quantisation, two counts or more, and the filter's overshoot).
+  auto median = [](const std::vector<double>& x, std::size_t a, std::size_t b) -> double {
+    std::vector<double> v(x.begin() + static_cast<std::ptrdiff_t>(a), x.begin() + static_cast<std::ptrdiff_t>(b));
+    if (v.empty()) return NAN;
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  auto swing = [&](const std::vector<double>& x, std::size_t a, std::size_t b, std::size_t at) {
+    return std::fabs(median(x, at, b) - median(x, a, at));
   };
   for (std::size_t i = 0; i < at.size(); ++i) {
     const std::size_t a = i == 0 ? s.begin : (at[i - 1] + at[i]) / 2;
     const std::size_t b = i + 1 == at.size() ? s.end : (at[i] + at[i + 1]) / 2;
     LostMotion l;
     l.t = s.t[at[i]], l.direction = direction[i];
-    if (measured_gap) l.measured = swing(*measured_gap, a, b);
-    l.model = swing(model_gap, a, b);
+    if (measured_gap) l.measured = swing(*measured_gap, a, b, at[i]);
+    l.model = swing(model_gap, a, b, at[i]);
     out.push_back(l);
   }
   return out;
@@ -621,6 +795,7 @@ FlightFit load_coulomb_in_flight(const Signals& s, const LoadSide& l, const std:
   if (!flight.ok) return flight;
   Candidate c;
   c.effect = "coulomb_load";
+  c.rms = c.rms_fit = c.rms_holdout = NAN;  // judged on the load's flights (positions), not on the torque
   c.parameters = {{"torque", flight.beta * current[kJL], flight.sigma * current[kJL]}};
   c.delta_bic = flight.delta_bic;
   c.at_range_edge = !(flight.beta > 0);
@@ -666,6 +841,7 @@ void both_encoders(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   const double n_eff = static_cast<double>(rigid.contact.size()) / tau_int_on(xf, rigid.contact);
   Candidate c;
   c.effect = "compliance";
+  c.rms = c.rms_fit = c.rms_holdout = NAN;  // judged on the gap's faces (positions), not on the torque
   if (std::isfinite(compliant.sse) && compliant.contact.size() > 10) {
     c.delta_bic = n_eff * std::log(std::max(compliant.sse, 1e-300) / std::max(rigid.sse, 1e-300)) + 2 * std::log(n_eff);  // 1/kc and cm/kc
     c.at_range_edge = !(compliant.c > 0);
@@ -682,7 +858,9 @@ void both_encoders(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   two.gap_offset = g.x0, two.contact_fraction = g.contact_fraction;
   std::vector<double> model_gap = load_observer(s.qmf, s.vm, s.am, s.fs, g.b, g.x0, f.m[kJL], f.m[kFL], f.m[kTL]);
   for (std::size_t k = 0; k < s.size(); ++k) model_gap[k] -= g.c * R[k];
-  two.reversals = lost_motion(s, &xf, model_gap);
+  // The model's lost motion as the measured one is read: the swing of the gap through the same
+  // filter (whose step response overshoots at each impact: the swing exceeds b by as much).
+  two.reversals = lost_motion(s, &xf, measurements::zero_phase_filter(model_gap, s.filter));
   two.loop_motor = s.qm, two.loop_load = s.qL, two.loop_model.resize(s.size());
   for (std::size_t k = 0; k < s.size(); ++k) two.loop_model[k] = s.qm[k] + model_gap[k];
 }
@@ -709,7 +887,7 @@ void motor_encoder(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   final_fit.m = f.nominal;
   fit_shape(s, final_fit, f.free, coulomb_load, false, samples);
   f.sigma = observer_sigma(s, final_fit, f.free, coulomb_load, samples);
-  f.m = final_fit.m, f.b = final_fit.z.b, f.sigma_b = final_fit.sigma_b;
+  f.m = final_fit.m, f.b = final_fit.z.b, f.sigma_b = profile_sigma_b(s, final_fit, f.free, samples);
   // The load's parameters untied from the shape: least squares of the summed equation on the
   // load the fitted shape observes (in contact the load's viscous friction is the total less the
   // motor's; the shape's α = FL/JL only governs the brief flights).
@@ -722,8 +900,11 @@ void motor_encoder(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   f.all = samples;
   two.torque_rms_rigid = std::sqrt(final_fit.sse_rigid / static_cast<double>(std::max<std::size_t>(1, samples.size())));
   two.contact_fraction = NAN;
-  const std::vector<double> model_gap = load_observer(s.qmf, s.vm, s.am, s.fs, f.b, 0, f.m[kJL], f.m[kFL], f.m[kTL], f.compliance);
+  const std::vector<double> model_gap = observe(s, f.m, f.b, f.m[kJL], f.m[kFL], f.m[kTL], f.compliance);
   two.reversals = lost_motion(s, nullptr, model_gap);
+  two.backlash_sigma_moves = f.sigma_b;
+  two.backlash_sigma_timing = timing_sigma_b(model_gap, f.b, samples.empty() ? s.begin : samples.front(), s.end);
+  f.sigma_b = std::hypot(f.sigma_b, two.backlash_sigma_timing);
 }
 
 }  // namespace
@@ -749,9 +930,6 @@ Status status_of(const DriveDiscrepancyResult& r, const TwoBodyFindings& two) {
 void fill_result(const Signals& s, const Fitted& f, DriveDiscrepancyResult& r) {
   r.rms_given = rms_on(f.r_given, f.all), r.rms_before = rms_on(f.r_nominal, f.all), r.rms_after = rms_on(f.r_after, f.all);
   r.tau_int_before = tau_int_on(f.r_nominal, f.all), r.tau_int_after = tau_int_on(f.r_after, f.all);
-  std::vector<double> inner;
-  for (std::size_t k : f.all) inner.push_back(f.r_after[k]);
-  r.noise = estimate_noise(inner);
   for (Candidate& c : r.effects) {
     const auto it = std::find_if(effect_columns().begin(), effect_columns().end(), [&](const auto& e) { return e.first == c.effect; });
     if (it != effect_columns().end()) c.parameters = {{"torque", f.m[it->second], f.sigma[static_cast<std::size_t>(it->second)]}};
@@ -796,6 +974,10 @@ DriveDiscrepancyResult find(const model::CaseSpec& spec, const measurements::Mea
                                 " times: with the motor encoder alone the backlash needs at least 5 reversals (or log theta_load)");
   two.rigid = !(f.b > 3 * f.sigma_b);
   fill_result(s, f, result);
+  // The noise level: the encoders' quantisation and the drive's noise propagated (not the Δ⁴
+  // rule on the residual, which is filtered: far below its noise).
+  two.noise = noise_level(s, f.m);
+  result.noise = two.noise.level, result.position_noise = two.noise.sigma_motor, result.drive_noise = two.noise.sigma_drive;
   result.given = given;
   result.nominal = result.parameters = given;
   result.nominal.JL = f.nominal[kJL], result.nominal.FL = f.nominal[kFL], result.nominal.Jm = f.nominal[kJm], result.nominal.Fm = f.nominal[kFm];

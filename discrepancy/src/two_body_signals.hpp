@@ -92,6 +92,9 @@ std::vector<double> ceres_sigma(const std::function<void(const double*, double*)
                                 std::vector<double>& x, const std::vector<double>& lower, bool polish,
                                 double relative_step = 1e-6);
 
+/// The torque residual's noise level for the model m (two_body_noise.cpp; docs/discrepancy.md).
+TwoBodyNoise noise_level(const Signals& s, const Theta& m);
+
 /// The workflow (find_drive_discrepancy routes a case with backlash > 0 here).
 DriveDiscrepancyResult find(const model::CaseSpec& spec, const measurements::MeasuredRecord& data, const DriveOptions& options);
 

@@ -245,7 +245,8 @@ TEST(DiscrepancyCommand, exam_TheReadmeExamplesRunAndSayWhatTheReadmeSays) {
       continue;
     }
     if (command.find("two_body_drive") != std::string::npos) {  // a drive with a gap, both encoders
-      EXPECT_NE(r.out.find(": partly_explained ("), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find(": parameters_corrected ("), std::string::npos) << r.out;  // the residual at its noise (issue 22)
+      EXPECT_NE(r.out.find("(noise level 0.035)"), std::string::npos) << r.out;
       EXPECT_NE(r.out.find("backlash        0.0261799 -> 0.0349 ± 1.9e-06"), std::string::npos) << r.out;
       EXPECT_NE(r.out.find("load.J          0.0375 -> 0.0298961 ± 9.3e-05"), std::string::npos) << r.out;
       EXPECT_NE(r.out.find("load.F          0.05 -> 0.0500209"), std::string::npos) << r.out;

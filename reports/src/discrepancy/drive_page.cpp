@@ -211,7 +211,17 @@ void candidates_chart(const DriveDiscrepancyResult& r, std::vector<reports::Plot
 std::optional<std::string> two_body_drive_figures(const DriveDiscrepancyResult& r, std::vector<reports::Plot>& figures,
                                                   std::vector<std::pair<std::string, std::string>>& files) {
   const std::pair<std::size_t, std::size_t> range{0, static_cast<std::size_t>(std::lower_bound(r.t.begin(), r.t.end(), r.t.front() + 3) - r.t.begin())};
-  torque_over_time(r, range, "drive torque [N·m]", figures);
+  // The corrected model drawn whether or not an effect was named (the parameter corrections
+  // change it); its label says when it is the best nominal's own curve.
+  const std::vector<double> t = slice(r.t, range), measured = slice(r.torque_measured, range),
+                            nominal = slice(r.torque_nominal, range), corrected = slice(r.torque_corrected, range);
+  const bool same = r.torque_corrected == r.torque_nominal;
+  figures.push_back(line_plot("torque_over_time", "Drive torque: measured, and what each model needs along the measured motion",
+                              "t [s]", "drive torque [N·m]",
+                              {{"measured (filtered)", "#222", &t, &measured},
+                               {"best nominal needs", "#c33", &t, &nominal, true},
+                               {same ? "corrected needs (= the best nominal: no effect named)" : "corrected needs", "#2a7", &t, &corrected}}));
+  figures.back().key = "below";
   detail::two_body_figures(*r.two_body, figures);
   candidates_chart(r, figures);
   return add_figures(figures, files);
@@ -281,9 +291,23 @@ void drive_page_head(std::ostringstream& md, const model::CaseSpec& model, const
                                       number(r.spectrum_floor) + " position²/Hz)"
                                 : " (set by the user)")
      << ".\n\n";
-  md << "Noise: position σ = " << number(r.position_noise) << ", drive σ = " << number(r.drive_noise)
-     << "; propagated through the filter and the derivatives, the torque residual's noise level is " << number(r.noise)
-     << ". At rest: |velocity| < " << number(r.rest_speed) << ".\n\n";
+  if (r.two_body) {  // a drive with a gap: the sources named (docs/discrepancy.md, "Noise level on a drive with a gap")
+    const TwoBodyNoise& n = r.two_body->noise;
+    auto encoder = [](double step, double sigma) {
+      return step > 0 ? "step " + number(step) + " → σ = step/√12 = " + number(sigma) : "not quantised, σ = " + number(sigma) + " (Δ⁴ rule)";
+    };
+    md << "Noise level of the torque residual: " << number(n.level) << ", the sources propagated through the filter, the "
+       << "differences and the summed equation and added in quadrature — the motor encoder (" << encoder(n.step_motor, n.sigma_motor)
+       << "): " << number(n.motor);
+    if (r.two_body->load_encoder) md << "; the load encoder (" << encoder(n.step_load, n.sigma_load) << "): " << number(n.load);
+    else md << " (carried with the two bodies' inertia: the observed load rides on the motor's counts)";
+    md << "; the logged drive (σ = " << number(n.sigma_drive) << ", read on its band above the cut-off less the controller's "
+       << "reaction to the encoders' counts): " << number(n.drive) << ". At rest: |velocity| < " << number(r.rest_speed) << ".\n\n";
+  } else {
+    md << "Noise: position σ = " << number(r.position_noise) << ", drive σ = " << number(r.drive_noise)
+       << "; propagated through the filter and the derivatives, the torque residual's noise level is " << number(r.noise)
+       << ". At rest: |velocity| < " << number(r.rest_speed) << ".\n\n";
+  }
   md << "Units are the record's own (SI); the figures label them for a linear drive such as EMPS: position in m, velocity "
         "in m/s, the drive and its residual (the workflow's \"torque\") in N; for a rotary record read rad, rad/s and N·m.\n\n";
 }
@@ -362,7 +386,9 @@ void drive_page_candidates(std::ostringstream& md, const DriveDiscrepancyResult&
     for (const Candidate& c : r.rounds[k]) {
       md << "| " << c.effect << " | ";
       for (const Parameter& p : c.parameters) md << p.name << " = " << number(p.value) << " ";
-      md << "| " << number(c.rms) << " | " << number(c.rms_holdout) << " | " << number(c.delta_bic) << " | "
+      // NaN: a candidate judged off the torque (a drive with a gap: on the gap's faces, the load's flights)
+      auto rms = [](double v) { return std::isnan(v) ? std::string("— (judged on positions)") : number(v); };
+      md << "| " << rms(c.rms) << " | " << rms(c.rms_holdout) << " | " << number(c.delta_bic) << " | "
          << (c.at_range_edge ? "yes" : "no") << " | " << (c.decisive ? "yes" : "no") << " |\n";
     }
     md << "\n";

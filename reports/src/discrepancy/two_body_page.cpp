@@ -5,6 +5,7 @@
 #include "page_json.hpp"
 #include "plots.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace backlash::discrepancy::detail {
@@ -19,6 +20,13 @@ nlohmann::json two_body_json(const TwoBodyFindings& two) {
           {"gap_offset", two.gap_offset},
           {"contact_fraction", json_number(two.contact_fraction)},
           {"torque_rms_rigid", json_number(two.torque_rms_rigid)},
+          {"noise", {{"level", json_number(two.noise.level)}, {"drive", json_number(two.noise.drive)},
+                     {"motor_encoder", json_number(two.noise.motor)}, {"load_encoder", json_number(two.noise.load)},
+                     {"sigma_drive", json_number(two.noise.sigma_drive)}, {"sigma_motor", json_number(two.noise.sigma_motor)},
+                     {"sigma_load", json_number(two.noise.sigma_load)}, {"step_motor", two.noise.step_motor},
+                     {"step_load", two.noise.step_load}}},
+          {"backlash_sigma_moves", json_number(two.backlash_sigma_moves)},
+          {"backlash_sigma_timing", json_number(two.backlash_sigma_timing)},
           {"reversals", reversals}};
 }
 
@@ -31,13 +39,27 @@ void two_body_figures(const TwoBodyFindings& two, std::vector<reports::Plot>& fi
   }
   std::vector<Curve> lost{{"model", "#2a7", &index, &model}};
   if (two.load_encoder) lost.insert(lost.begin(), Curve{"measured", "#222", &index, &measured});
-  figures.push_back(line_plot("lost_motion", "Lost motion at each reversal of the motor (the gap's swing face to face)",
-                              "reversal", "lost motion [rad]", lost));
+  reports::Plot plot = line_plot("lost_motion", "Lost motion at each reversal of the motor (the gap's swing face to face)",
+                                 "reversal", "lost motion [rad]", lost);
+  // The y range padded (a tenth of the span, or 1 % of the value when all are equal): a
+  // curve on the range's end would lie on the axis, unseen.
+  double lo = INFINITY, hi = -INFINITY;
+  for (const Curve& c : lost)
+    for (double y : *c.y)
+      if (std::isfinite(y)) lo = std::min(lo, y), hi = std::max(hi, y);
+  if (lo <= hi) {
+    const double pad = hi > lo ? 0.1 * (hi - lo) : 0.01 * std::max(std::fabs(hi), 1e-12);
+    plot.y_range = {lo - pad, hi + pad};
+  }
+  plot.key = "below";
+  figures.push_back(plot);
   if (!two.load_encoder) return;
-  figures.push_back(line_plot("hysteresis_loop", "Hysteresis loop: the load against the motor", "motor position [rad]",
-                              "load position [rad]",
-                              {{"measured", "#222", &two.loop_motor, &two.loop_load},
-                               {"model (load observer on the measured motor)", "#2a7", &two.loop_motor, &two.loop_model, true}}));
+  reports::Plot loop = line_plot("hysteresis_loop", "Hysteresis loop: the load against the motor", "motor position [rad]",
+                                 "load position [rad]",
+                                 {{"measured", "#222", &two.loop_motor, &two.loop_load},
+                                  {"model (load observer on the measured motor)", "#2a7", &two.loop_motor, &two.loop_model, true}});
+  loop.key = "inside left top";  // the loop runs from the bottom left to the top right
+  figures.push_back(loop);
 }
 
 void two_body_page(std::ostringstream& md, const TwoBodyFindings& two, bool drawn) {
@@ -47,6 +69,10 @@ void two_body_page(std::ostringstream& md, const TwoBodyFindings& two, bool draw
   for (const ParameterCorrection& c : two.parameter_corrections)
     md << "| " << c.key << " | " << number(c.nominal) << " | " << number(c.fitted) << " | " << number(c.uncertainty) << " | "
        << number(c.ratio) << " |\n";
+  if (std::isfinite(two.backlash_sigma_timing))
+    md << "\nσ of the backlash: " << number(two.backlash_sigma_moves) << " from the scatter over the moves (jackknife) and "
+       << number(two.backlash_sigma_timing) << " from the separations and impacts placed on whole samples (shared by every "
+       << "move), added in quadrature.\n";
   if (two.rigid) md << "\n**A rigid drive**: the backlash is not distinguishable from 0 (within 3σ).\n";
   if (two.load_encoder)
     md << "\nThe encoders' relative zero: " << number(two.gap_offset) << "; " << number(100 * two.contact_fraction)

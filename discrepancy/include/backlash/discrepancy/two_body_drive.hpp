@@ -50,6 +50,19 @@ struct LostMotion {
   double model = NAN;      ///< the fitted model's: b plus the change of the mesh's deflection
 };
 
+/// The torque residual's noise level and where it comes from (docs/discrepancy.md, "Noise level
+/// on a drive with a gap"): each source's σ and its share of the level [torque], the shares
+/// added in quadrature.  An encoder's σ is its step/√12 (step 0: not quantised, the Δ⁴ rule on
+/// its position); the drive's is read on its band above the cut-off, less the controller's
+/// reaction to the encoders' counts.
+struct TwoBodyNoise {
+  double level = NAN;                            ///< [torque] the residual's expected RMS
+  double drive = NAN, motor = NAN, load = 0;     ///< each source's share [torque] (load: both encoders)
+  double sigma_drive = NAN;                      ///< σ of gain·drive [torque]
+  double sigma_motor = NAN, sigma_load = NAN;    ///< σ of each encoder [position]
+  double step_motor = 0, step_load = 0;          ///< each encoder's step (0: not quantised)
+};
+
 /// What the workflow finds on a drive with a gap (in DriveDiscrepancyResult::two_body).
 struct TwoBodyFindings {
   bool load_encoder = false;  ///< theta_load logged: the gap observed directly
@@ -61,6 +74,10 @@ struct TwoBodyFindings {
   bool rigid = false;         ///< the backlash is not distinguishable from 0 (within 3σ)
   double torque_rms_rigid = NAN;  ///< torque RMS of the same fit with b = 0 (motor encoder alone)
   std::vector<LostMotion> reversals;
+  TwoBodyNoise noise;         ///< the noise level the status compares the residual with
+  /// The motor encoder alone: σ of the backlash = √(moves² + timing²) — the jackknife over the
+  /// moves, and the events' timing on whole samples, shared by every move (a bias).
+  double backlash_sigma_moves = NAN, backlash_sigma_timing = NAN;
   /// The hysteresis loop (both encoders): θL against θm, measured and the model's (the fitted
   /// load observer on the measured motor motion), every sample.
   std::vector<double> loop_motor, loop_load, loop_model;
