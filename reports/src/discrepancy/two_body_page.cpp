@@ -34,13 +34,15 @@ void two_body_figures(const TwoBodyFindings& two, std::vector<reports::Plot>& fi
   std::vector<double> index, measured, model;  // line_plot copies the points
   for (std::size_t i = 0; i < two.reversals.size(); ++i) {
     index.push_back(static_cast<double>(i + 1));
-    measured.push_back(two.reversals[i].measured);
-    model.push_back(two.reversals[i].model);
+    // In mrad: the two agree to a few µrad, and gnuplot's 6 significant digits on rad ticks
+    // would print the same label on neighbouring ticks.
+    measured.push_back(1e3 * two.reversals[i].measured);
+    model.push_back(1e3 * two.reversals[i].model);
   }
   std::vector<Curve> lost{{"model", "#2a7", &index, &model}};
   if (two.load_encoder) lost.insert(lost.begin(), Curve{"measured", "#222", &index, &measured});
   reports::Plot plot = line_plot("lost_motion", "Lost motion at each reversal of the motor (the gap's swing face to face)",
-                                 "reversal", "lost motion [rad]", lost);
+                                 "reversal", "lost motion [mrad]", lost);
   // The y range padded (a tenth of the span, or 1 % of the value when all are equal): a
   // curve on the range's end would lie on the axis, unseen.
   double lo = INFINITY, hi = -INFINITY;
