@@ -224,17 +224,36 @@ struct GapFit {
   std::vector<signed char> face;  // at every sample: ±1 in contact, 0 in flight
   double sse = INFINITY;
   double contact_fraction = 0;
+  bool raw = false;  // read on the raw gap (contact stretches shorter than the filter's length)
 };
 
-bool solve_gap(const Signals& s, const std::vector<double>& xf, const std::vector<double>& R, bool compliant, GapFit& g) {
+// The samples in contact needed on each face: b is the difference of the two faces (with one
+// face alone it is not identified — it came out 0 on a loop closed on the load encoder).
+constexpr std::size_t kMinOnFace = 5;
+
+// The main lobe of the zero-phase filter's impulse response: the samples from its centre to its
+// first change of sign.
+std::size_t main_lobe(const measurements::ButterworthLowPass& filter) {
+  const std::size_t n = 1025, middle = n / 2;
+  std::vector<double> impulse(n, 0.0);
+  impulse[middle] = 1;
+  const std::vector<double> h = measurements::zero_phase_filter(impulse, filter);
+  std::size_t m = 1;
+  while (m < middle && h[middle + m] > 0) ++m;
+  return m;
+}
+
+bool solve_gap(const Signals& s, const std::vector<double>& xf, const std::vector<double>& R, bool compliant, std::size_t margin,
+               GapFit& g) {
   std::vector<std::size_t> rows;
-  for (std::size_t k = s.begin + s.reach; k + s.reach < s.end; ++k) {
+  std::size_t on_face[2] = {0, 0};
+  for (std::size_t k = s.begin + margin; k + margin < s.end; ++k) {
     bool steady = g.face[k] != 0;
-    for (std::size_t j = k - s.reach; steady && j <= k + s.reach; ++j) steady = g.face[j] == g.face[k];
-    if (steady) rows.push_back(k);
+    for (std::size_t j = k - margin; steady && j <= k + margin; ++j) steady = g.face[j] == g.face[k];
+    if (steady) rows.push_back(k), ++on_face[g.face[k] > 0];
   }
   const int cols = compliant ? 4 : 2;
-  if (rows.size() < 10) return false;
+  if (rows.size() < 10 || on_face[0] < kMinOnFace || on_face[1] < kMinOnFace) return false;  // b needs both faces
   Eigen::MatrixXd A(rows.size(), cols);
   Eigen::VectorXd y(rows.size());
   for (std::size_t i = 0; i < rows.size(); ++i) {
@@ -255,10 +274,18 @@ bool solve_gap(const Signals& s, const std::vector<double>& xf, const std::vecto
 // on face σ it is −σ·P with P > 0; so the samples whose |R| exceeds a tenth of its 95th percentile
 // are in contact on face −sgn R, and stay so while R keeps its sign and |R| a fortieth of that
 // percentile (a hysteresis: a cruise whose viscous torque sits near the tenth would otherwise
-// flicker in and out of contact with the noise, and no stretch would be steady).  Those within
-// the filter's length of a change are left out by solve_gap.  b, x0 (and 1/kc) by least squares
-// over them.
-GapFit fit_gap(const Signals& s, const std::vector<double>& xf, const std::vector<double>& R, bool compliant) {
+// flicker in and out of contact with the noise, and no stretch would be steady).  b, x0 (and
+// 1/kc) by least squares over them, on both faces:
+//  - the filtered gap xf where the face holds over the filter's whole length around the sample
+//    (there the filter commutes with the face's linear model: exact);
+//  - where no such stretch holds on both faces (contact stretches shorter than the filter's
+//    length: a loop on the load encoder hunting in the gap, pushing the load in short strokes),
+//    the raw gap x = θL − θm, which needs no filter (on a rigid face it is x0 + σ·b/2 to the
+//    encoders' counts), over the samples whose face holds for the main lobe of the filter's
+//    impulse response around them — the time by which the filtered R, the classifier, can
+//    misplace an impact or a separation (docs/discrepancy.md).
+GapFit fit_gap(const Signals& s, const std::vector<double>& xf, const std::vector<double>& x, const std::vector<double>& R,
+               bool compliant) {
   std::vector<double> size;
   for (std::size_t k = s.begin; k < s.end; ++k) size.push_back(std::fabs(R[k]));
   std::nth_element(size.begin(), size.begin() + static_cast<std::ptrdiff_t>(95 * size.size() / 100), size.end());
@@ -271,20 +298,24 @@ GapFit fit_gap(const Signals& s, const std::vector<double>& xf, const std::vecto
     const bool held = k > s.begin && g.face[k - 1] == face && std::fabs(R[k]) > threshold / 4;
     if (held || std::fabs(R[k]) > threshold) g.face[k] = face;
   }
-  if (!solve_gap(s, xf, R, compliant, g)) g.sse = INFINITY;
+  if (!solve_gap(s, xf, R, compliant, s.reach, g)) {
+    g.raw = true;
+    if (!solve_gap(s, x, R, compliant, main_lobe(s.filter), g)) g.sse = INFINITY;
+  }
   g.contact_fraction = static_cast<double>(g.contact.size()) / static_cast<double>(std::max<std::size_t>(1, s.end - s.begin));
   return g;
 }
 
 // The uncertainties of the gap's fit (Ceres's covariance of the same linear model).
-void gap_sigma(const std::vector<double>& xf, const std::vector<double>& R, GapFit& g) {
+void gap_sigma(const std::vector<double>& xf, const std::vector<double>& x_raw, const std::vector<double>& R, GapFit& g) {
+  const std::vector<double>& y = g.raw ? x_raw : xf;
   std::vector<double> x{g.x0, g.b, g.c, g.d};
   const std::size_t k = g.c != 0 ? 4 : 2;
   x.resize(k);
   const std::function<void(const double*, double*)> f = [&](const double* p, double* r) {
     for (std::size_t i = 0; i < g.contact.size(); ++i) {
       const std::size_t j = g.contact[i];
-      r[i] = xf[j] - (p[0] + 0.5 * g.face[j] * p[1] - (k == 4 ? p[2] * R[j] + p[3] * g.xdot[j] : 0.0));
+      r[i] = y[j] - (p[0] + 0.5 * g.face[j] * p[1] - (k == 4 ? p[2] * R[j] + p[3] * g.xdot[j] : 0.0));
     }
   };
   const std::vector<double> sigma = ceres_sigma(f, g.contact.size(), x, std::vector<double>(k, -INFINITY), false);
@@ -784,12 +815,13 @@ struct Fitted {
 // (flight_coulomb with α = FL/JL and the faces of the `summed` model, whose viscous friction is
 // right once the sum is named) and, when decisive, named first and held in `current` (the
 // summed equation's rounds are then run again, and name the motor's).
-FlightFit load_coulomb_in_flight(const Signals& s, const LoadSide& l, const std::vector<double>& xf, const DriveOptions& options,
+FlightFit load_coulomb_in_flight(const Signals& s, const LoadSide& l, const std::vector<double>& xf, const std::vector<double>& x,
+                                 const DriveOptions& options,
                                  const Theta& summed, Theta& current, DriveDiscrepancyResult& result) {
   if (current[kTL] != 0) return {};
   std::vector<double> R(s.size());
   for (std::size_t k = 0; k < s.size(); ++k) R[k] = summed[kJL] * l.aL[k] + summed[kFL] * l.vL[k] + (summed[kTL] + summed[kTm]) * l.sL_f[k];
-  const GapFit g = fit_gap(s, xf, R, false);
+  const GapFit g = fit_gap(s, xf, x, R, false);
   if (!std::isfinite(g.sse) || !(g.b > 0)) return {};
   const FlightFit flight = flight_coulomb(s, l, g.x0, g.b, summed[kFL] / summed[kJL]);
   if (!flight.ok) return flight;
@@ -823,7 +855,7 @@ void both_encoders(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   FreeSet free = f.free;
   f.m = name_effects(w, f.nominal, free, result);
   Theta current = f.nominal;
-  const FlightFit flight = load_coulomb_in_flight(s, l, xf, options, f.m, current, result);
+  const FlightFit flight = load_coulomb_in_flight(s, l, xf, x, options, f.m, current, result);
   if (current[kTL] != f.nominal[kTL]) f.m = name_effects(w, current, f.free, result);
   else f.free = free;
   f.sigma = summed_sigma(s, l, f.m, f.free, w.all);
@@ -834,10 +866,10 @@ void both_encoders(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   f.all = w.all;
   // The gap on its faces, with the load's inverse dynamics R of the fitted model.
   for (std::size_t k = 0; k < s.size(); ++k) R[k] = f.m[kJL] * l.aL[k] + f.m[kFL] * l.vL[k] + f.m[kTL] * l.sL_f[k];
-  GapFit rigid = fit_gap(s, xf, R, false);
+  GapFit rigid = fit_gap(s, xf, x, R, false);
   GapFit g = rigid;
-  if (!std::isfinite(g.sse)) throw std::invalid_argument(s.name + ": theta_load: the gap theta_load - theta_motor shows no contact plateau to read the backlash on");
-  GapFit compliant = fit_gap(s, xf, R, true);
+  if (!std::isfinite(g.sse)) throw std::invalid_argument(s.name + ": theta_load: the gap theta_load - theta_motor shows no contact on both faces to read the backlash on");
+  GapFit compliant = fit_gap(s, xf, x, R, true);
   const double n_eff = static_cast<double>(rigid.contact.size()) / tau_int_on(xf, rigid.contact);
   Candidate c;
   c.effect = "compliance";
@@ -850,7 +882,7 @@ void both_encoders(const Signals& s, const DriveOptions& options, Fitted& f, Dri
   } else {
     c.failure = "too few samples in contact", c.delta_bic = INFINITY;
   }
-  gap_sigma(xf, R, g);
+  gap_sigma(xf, x, R, g);
   if (g.c > 0) c.parameters = {{"stiffness", 1 / g.c, g.sigma_c / (g.c * g.c)}};
   result.rounds.push_back({c});
   if (c.decisive) result.effects.push_back(c), result.corrected_effects.mesh_stiffness = 1 / g.c;

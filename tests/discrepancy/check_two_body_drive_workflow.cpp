@@ -16,7 +16,8 @@
 // a correction is tested, the load's J and F) off and lists them in [fit] free; the record has
 // both encoders or the motor encoder alone.  Recovered, with their reported σ:
 //   item1_backlash_*        the backlash, 0.1° to 20° and the thesis's 0.3 rad, within
-//                           max(5 %, 3σ) with both encoders and with the motor encoder alone;
+//                           max(5 %, 3σ) with both encoders and with the motor encoder alone
+//                           (with both encoders and the loop on the load: 5° and 20°);
 //   item3_load_*            the load's inertia and viscous friction within 10 %;
 //   item3_mesh_stiffness    a compliant mesh named (`compliance`) with its stiffness within 10 %
 //                           (both encoders; with the motor encoder alone not fitted, documented,
@@ -336,6 +337,17 @@ TEST(TwoBodyDriveWorkflow, item1_backlash_both_encoders) {
   for (double b : backlash_sizes()) expect_backlash_recovered(drive(b, true), b);
   if (full_matrix())
     for (double b : backlash_sizes()) expect_backlash_recovered(drive(b, true, true, 2), b);
+}
+
+// Both encoders, the position loop closed on the LOAD encoder: the loop hunts in the gap, the
+// motor pushing the load in strokes (60–90 ms) shorter than the filter's length (about 100 ms at
+// the spectrum's 82 Hz cut-off), so no contact stretch outlasts the filter.  Read on the filtered
+// gap, from 5° up the steady samples lay on one face only: the backlash came out 0 at 5° and the
+// record was refused at 20° and 0.3 rad ("shows no contact plateau").  Now read on the raw gap
+// (docs/discrepancy.md, "Both encoders: the gap is observed").  5° and 20° here (a few seconds
+// each); every size with BACKLASH_TWO_BODY_MATRIX=1.
+TEST(TwoBodyDriveWorkflow, item1_backlash_both_encoders_loop_on_load) {
+  for (double b : {5 * kDegree, 20 * kDegree}) expect_backlash_recovered(drive(b, true, true, 2), b);
 }
 
 // With the motor encoder alone every size, 1° included (it was +6.35 %, about 8 σ, before the
