@@ -7,7 +7,9 @@
 
 #include "backlash/api/backlash.hpp"
 
+#include <algorithm>
 #include <memory>
+#include <string>
 #include <optional>
 
 namespace backlash::cli {
@@ -29,6 +31,15 @@ void run_trace(const TraceOptions& options) {
   const api::Model model(api::load(options.case_name));
   const api::Trace lines = v0 ? model.trace(*v0) : model.trace();
   print(options.json ? lines.json() : lines.text());
+  // A point its search could not decide is a work limit, as `simulate`'s work_limit: the output
+  // above is complete (those points with status work_limit), and the command exits 3 with the reason.
+  const auto& points = lines.lines.points;
+  const auto unresolved = std::count_if(points.begin(), points.end(), [](const numeric::DividingLinePoint& p) {
+    return p.status == numeric::RecombinationStatus::Unresolved;
+  });
+  if (unresolved > 0)
+    throw StoppedEarly(std::to_string(unresolved) + " of " + std::to_string(points.size()) +
+                       " dividing-line points unresolved (work_limit): " + lines.lines.work_limit);
 }
 
 }  // namespace

@@ -477,7 +477,7 @@ nlohmann::json maybe(bool present, double value) { return present ? nlohmann::js
 std::string Trace::json() const {
   nlohmann::json points = nlohmann::json::array();
   for (const numeric::DividingLinePoint& p : lines.points) {
-    const bool ok = p.status != numeric::RecombinationStatus::NoRecombination;
+    const bool ok = numeric::has_impact(p.status);
     points.push_back({{"v0", p.dtheta_m0},
                       {"status", numeric::to_string(p.status)},
                       {"grazing", p.grazing},
@@ -489,7 +489,7 @@ std::string Trace::json() const {
                       {"theta_o", maybe(ok, p.theta_o)},
                       {"dtheta_o", maybe(ok, p.dtheta_o)}});
   }
-  const nlohmann::json out{
+  nlohmann::json out{
       {"case", case_id},
       {"cot_phi", lines.cot_phi},
       {"threshold", lines.threshold ? nlohmann::json(*lines.threshold) : nlohmann::json(nullptr)},
@@ -497,6 +497,7 @@ std::string Trace::json() const {
       {"evaluator", evaluator},
       {"convention", "theta_m(0) = theta_L(0) = theta_R + cot_phi*v0; m, L before the impact, o after it (eq. 24)"},
       {"points", points}};
+  if (!lines.work_limit.empty()) out["work_limit"] = lines.work_limit;  // only when a point is unresolved
   return detail::document(out);
 }
 
@@ -504,7 +505,7 @@ std::string Trace::csv() const {
   std::string out = "v0,status,grazing,t,theta_m,dtheta_m,theta_L,dtheta_L,theta_o,dtheta_o\n";
   for (const numeric::DividingLinePoint& p : lines.points) {
     appendf(out, "%.17g,%s,%s", p.dtheta_m0, numeric::to_string(p.status), p.grazing ? "true" : "false");
-    if (p.status == numeric::RecombinationStatus::NoRecombination)
+    if (!numeric::has_impact(p.status))
       out += ",,,,,,,\n";
     else
       appendf(out, ",%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", p.t, p.theta_m, p.dtheta_m, p.theta_L, p.dtheta_L,
@@ -520,13 +521,14 @@ std::string Trace::text() const {
   appendf(out, "\n%10s %-13s %14s %12s %12s %12s %12s %12s %12s\n", "dtheta_m0", "status", "t", "theta_m", "dtheta_m",
           "theta_L", "dtheta_L", "theta_o", "dtheta_o+");
   for (const numeric::DividingLinePoint& p : lines.points) {
-    if (p.status == numeric::RecombinationStatus::NoRecombination) {
-      appendf(out, "%10.6g %-13s\n", p.dtheta_m0, "none");
+    if (!numeric::has_impact(p.status)) {
+      appendf(out, "%10.6g %-13s\n", p.dtheta_m0, numeric::to_string(p.status));
       continue;
     }
     appendf(out, "%10.6g %-13s %14.10f %12.8f %12.8f %12.8f %12.8f %12.8f %12.8f\n", p.dtheta_m0,
             numeric::to_string(p.status), p.t, p.theta_m, p.dtheta_m, p.theta_L, p.dtheta_L, p.theta_o, p.dtheta_o);
   }
+  if (!lines.work_limit.empty()) appendf(out, "work_limit: %s\n", lines.work_limit.c_str());
   return out;
 }
 

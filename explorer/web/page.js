@@ -161,6 +161,11 @@
     text += c.status === "limit_cycle"
       ? `limit cycle: peak-to-peak ${c.peak_to_peak}, period ${c.period.toPrecision(8)} s, ${c.stable ? "stable" : "unstable"}\n`
       : `no limit cycle (${c.status}): ${c.reason}\n`;
+    const tr = S.portrait.trace;
+    if (tr.work_limit) {  // trace's points its search could not decide (status work_limit), as the CLI's exit 3
+      const n = tr.points.filter((q) => q.status === "work_limit").length;
+      text += `dividing lines: ${n} of ${tr.points.length} points undecided (work_limit): ${tr.work_limit}\n`;
+    }
     if (S.step) text += `step response: ${S.step.simulation.status}, ${S.step.simulation.events.length} events, ${S.step.ms.toFixed(2)} ms\n`;
     const last = S.trajectories[S.trajectories.length - 1];
     if (last) text += `last trajectory: ${last.simulation.status}, ${last.simulation.events.length} events, ${last.ms.toFixed(2)} ms` +

@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 namespace backlash::numeric {
 
@@ -16,6 +18,7 @@ const char* to_string(RecombinationStatus status) {
     case RecombinationStatus::Recombination: return "recombination";
     case RecombinationStatus::Recontact: return "recontact";
     case RecombinationStatus::NoRecombination: return "none";
+    case RecombinationStatus::Unresolved: return "work_limit";
   }
   return "?";
 }
@@ -73,7 +76,31 @@ DividingLinePoint point_by_profile(const ValidatedEvaluator& evaluator, double v
 constexpr double direct_search_velocity_limit = 1e3;
 }  // namespace
 
+namespace {
+
+// A point found in error coordinates, back in the case's: its angles shifted by θR.
+void shift_angles(DividingLinePoint& point, double theta_R) {
+  if (!has_impact(point.status)) return;
+  point.theta_m += theta_R;
+  point.theta_L += theta_R;
+  point.theta_o += theta_R;
+}
+
+std::string budget_reason(const SearchBudgetExhausted& budget, double horizon) {
+  char where[120];
+  std::snprintf(where, sizeof where, " at t = %.6g s of the flight from the separation line (horizon %.6g s)",
+                budget.certified_until, horizon);
+  return budget.what() + std::string(where);
+}
+
+}  // namespace
+
 DividingLinePoint dividing_line_point(const ValidatedEvaluator& evaluator, double v0, const TraceOptions& options) {
+  if (const std::optional<ValidatedEvaluator> centred = in_error_coordinates(evaluator)) {
+    DividingLinePoint point = dividing_line_point(*centred, v0, options);
+    shift_angles(point, evaluator.parameters().theta_R);
+    return point;
+  }
   const Parameters& p = evaluator.parameters();
   DividingLinePoint point;
   point.dtheta_m0 = v0;
@@ -81,8 +108,14 @@ DividingLinePoint dividing_line_point(const ValidatedEvaluator& evaluator, doubl
   if (std::fabs(v0) > direct_search_velocity_limit) return point_by_profile(evaluator, v0, options);
   const LinearWitness gap = gap_witness(evaluator, v0, 0);
   const double scale = std::max({1.0, std::fabs(p.theta_R), std::fabs(evaluator.cot_phi() * v0)});
-  const auto event = detail::first_gap_event(free_mode_segment(p), gap.state, gap.value, std::copysign(p.backlash, v0),
-                                             horizon_of(p, options), scale, servo_time_unit(p));
+  std::optional<detail::GapEvent> event;
+  try {
+    event = detail::first_gap_event(free_mode_segment(p), gap.state, gap.value, std::copysign(p.backlash, v0),
+                                    horizon_of(p, options), scale, servo_time_unit(p));
+  } catch (const SearchBudgetExhausted&) {
+    point.status = RecombinationStatus::Unresolved;
+    return point;
+  }
   if (!event) return point;
   point.status = event->kind == detail::GapEventKind::FaceLeft ? RecombinationStatus::Recontact
                                                                : RecombinationStatus::Recombination;
@@ -98,11 +131,15 @@ namespace {
 // θ̇m0 (θR cancels in the gap), so gap(t; θ̇m0) = θ̇m0·f(t) with f = gap(t; 1): one profile
 // serves the whole dividing line.  Its knots are the certified departure t0, the certified
 // zeros of f' (in order), and `end`, the first return of f to 0 (or the horizon); f is
-// monotone between consecutive knots.
+// monotone between consecutive knots.  A search that runs out of its budget (SearchBudgetExhausted)
+// still certifies the span before where it stopped: the profile then ends there (`complete` false,
+// `work_limit` the reason), and decides the levels it reaches before that end.
 struct UnitGapProfile {
   bool valid = false;
   double end = 0;
   bool returns = false;  ///< f returns to 0 at `end` (recontact on the face left)
+  bool complete = true;  ///< `end` is the return or the horizon (not where a search stopped)
+  std::string work_limit;
   std::vector<double> knots, values;
 };
 
@@ -112,10 +149,20 @@ UnitGapProfile unit_gap_profile(const ValidatedEvaluator& evaluator, double hori
   const std::optional<double> t0 = return_search_start(evaluator, unit);
   if (!t0) return profile;
   const LinearWitness gap = gap_witness(evaluator, unit, 0);
-  const auto back = first_crossing(gap, *t0, horizon);
+  std::optional<Crossing> back;
+  const auto stopped = [&profile, horizon](const SearchBudgetExhausted& budget, double from) {
+    profile.complete = false;
+    profile.work_limit = budget_reason(budget, horizon);
+    profile.end = std::max(from, budget.certified_until);  // no zero of the witness on (from, end]
+  };
   profile.valid = true;
+  try {
+    back = first_crossing(gap, *t0, horizon);
+    profile.end = back ? back->t : horizon;
+  } catch (const SearchBudgetExhausted& budget) {
+    stopped(budget, *t0);  // f ≠ 0 on (t0, end]: no return there
+  }
   profile.returns = back.has_value();
-  profile.end = back ? back->t : horizon;
   LinearWitness slope = gap;  // zeros of f' = θ̇L − θ̇m
   slope.e = SmallRow::Zero(4);
   slope.e(1) = -1;
@@ -123,7 +170,7 @@ UnitGapProfile unit_gap_profile(const ValidatedEvaluator& evaluator, double hori
   slope.value = nullptr;
   auto add = [&](double t) {
     profile.knots.push_back(t);
-    profile.values.push_back(t == profile.end && back ? 0.0 : evaluator.free_state(t, unit).gap);
+    profile.values.push_back(t == profile.end && profile.returns ? 0.0 : evaluator.free_state(t, unit).gap);
   };
   // The separation point itself: f(0) = 0, and f is monotone on (0, t0] (its first non-vanishing
   // derivative keeps its sign there), so a level below f(t0) — a large θ̇m0, whose gap reaches
@@ -132,13 +179,18 @@ UnitGapProfile unit_gap_profile(const ValidatedEvaluator& evaluator, double hori
   profile.values.push_back(0.0);
   add(*t0);
   double t = *t0;
-  while (t < profile.end) {
-    const auto critical = first_crossing(slope, t, profile.end);
-    if (!critical) break;
-    add(critical->t);
-    t = critical->t + 1e-12 * std::max(1.0, critical->t);
+  try {
+    while (t < profile.end) {
+      const auto critical = first_crossing(slope, t, profile.end);
+      if (!critical) break;
+      add(critical->t);
+      t = critical->t + 1e-12 * std::max(1.0, critical->t);
+    }
+  } catch (const SearchBudgetExhausted& budget) {
+    stopped(budget, t);  // f' ≠ 0 on (t, end]: f monotone from the last knot to the new end
+    profile.returns = false;
   }
-  add(profile.end);
+  if (profile.complete || profile.end > profile.knots.back()) add(profile.end);
   return profile;
 }
 
@@ -173,6 +225,7 @@ DividingLinePoint point_from_profile(const ValidatedEvaluator& evaluator, const 
     point.status = RecombinationStatus::Recontact;
     point.t = profile.end;
   } else {
+    if (!profile.complete) point.status = RecombinationStatus::Unresolved;
     return point;
   }
   fill_impact_states(evaluator, point);
@@ -187,13 +240,18 @@ DividingLinePoint point_by_profile(const ValidatedEvaluator& evaluator, double v
 
 DividingLines trace_dividing_lines(const ValidatedEvaluator& evaluator, const std::vector<double>& grid,
                                    const TraceOptions& options) {
+  if (const std::optional<ValidatedEvaluator> centred = in_error_coordinates(evaluator)) {
+    DividingLines lines = trace_dividing_lines(*centred, grid, options);
+    for (DividingLinePoint& point : lines.points) shift_angles(point, evaluator.parameters().theta_R);
+    return lines;
+  }
   const Parameters& p = evaluator.parameters();
   DividingLines lines;
   lines.cot_phi = evaluator.cot_phi();
   lines.horizon = horizon_of(p, options);
   const UnitGapProfile profile = unit_gap_profile(evaluator, lines.horizon);
   // Threshold: b / sup f before the return; none when f still rises at the horizon (it grows without bound).
-  if (profile.valid && p.backlash > 0) {
+  if (profile.valid && profile.complete && p.backlash > 0) {
     double sup = 0;
     for (double v : profile.values) sup = std::max(sup, v);
     const FreeState at_end = evaluator.free_state(profile.end, 1.0);
@@ -202,6 +260,8 @@ DividingLines trace_dividing_lines(const ValidatedEvaluator& evaluator, const st
   }
   lines.points.reserve(grid.size());
   for (double v0 : grid) lines.points.push_back(point_from_profile(evaluator, profile, v0));
+  const auto unresolved = [](const DividingLinePoint& q) { return q.status == RecombinationStatus::Unresolved; };
+  if (std::any_of(lines.points.begin(), lines.points.end(), unresolved)) lines.work_limit = profile.work_limit;
   return lines;
 }
 

@@ -350,7 +350,8 @@ std::optional<LevelCrossing> search(const Sampler& W, const std::function<double
     while (!ends.empty()) {
       if (++examined > options.max_intervals)
         throw SearchBudgetExhausted("the certified event search exhausted its budget of " +
-                                    std::to_string(options.max_intervals) + " intervals");
+                                        std::to_string(options.max_intervals) + " intervals",
+                                    a.t);  // every interval left of a is decided: no crossing there
       End& end = ends.back();
       Sample& b = end.s;
       const double h = b.t - a.t;

@@ -276,7 +276,7 @@ void bind_trace(py::module_& m) {
   auto when_recombined = [](double Point::*field) {
     return [field](const api::Trace& r) {
       return column(r.lines.points, [field](const Point& p) {
-        return p.status == numeric::RecombinationStatus::NoRecombination ? NAN : p.*field;
+        return numeric::has_impact(p.status) ? p.*field : NAN;
       });
     };
   };

@@ -352,7 +352,7 @@ void add_separation_and_loci(Plot& plot, const CaseResult& c, const Window& w) {
                     std::string("linespoints lw 1.5 pt 9 ps 0.45 lc rgb '") + color_recombined + "'"};
   for (const numeric::DividingLines* lines : {&c.lines_positive, &c.lines_negative}) {
     for (const numeric::DividingLinePoint& q : lines->points) {
-      if (q.status == numeric::RecombinationStatus::NoRecombination) continue;
+      if (!numeric::has_impact(q.status)) continue;
       motor.x.push_back(q.theta_m);
       motor.y.push_back(q.dtheta_m);
       load.x.push_back(q.theta_L);

@@ -14,6 +14,16 @@
 // crossing can be skipped.  Where the gap per unit θ̇m0 is bounded (output at
 // the motor) small θ̇m0 never recombine: the threshold b / sup(gap/θ̇m0) is
 // reported, and those points come back with status NoRecombination.
+//
+// The searches run in error coordinates (θR = 0, in_error_coordinates; the angles are shifted
+// back by θR): with angles of size θR the witness's derivatives recompute K(θR − θm)/Jm, whose
+// rounding (an ulp of K·θR/Jm, exactly 0 only when θR's products round alike, e.g. θR = 1) is a
+// floor that does not decay with the flight's motion — near the horizon the gap's slope is
+// ~1e-29 against it, and the certified search, whose intervals shrink as (|w|/sup|w'''|)^(1/3),
+// ran out of intervals.  A point its search cannot decide within CrossingOptions::max_intervals
+// comes back with status Unresolved ("work_limit", DividingLines::work_limit says why), never an
+// exception; what the search certified before it stopped still decides the points it covers
+// (docs/design.md, "The JSON contract").
 #pragma once
 
 #include "backlash/numeric/validation.hpp"
@@ -24,8 +34,14 @@
 
 namespace backlash::numeric {
 
-enum class RecombinationStatus { Recombination, Recontact, NoRecombination };
+/// Unresolved: the certified search ran out of its budget before deciding this point (a work
+/// limit, "work_limit" in the outputs).
+enum class RecombinationStatus { Recombination, Recontact, NoRecombination, Unresolved };
 const char* to_string(RecombinationStatus status);
+/// Whether the point has an impact (Recombination or Recontact): its time and states are set.
+inline bool has_impact(RecombinationStatus status) {
+  return status == RecombinationStatus::Recombination || status == RecombinationStatus::Recontact;
+}
 
 struct DividingLinePoint {
   double dtheta_m0 = 0;
@@ -42,6 +58,9 @@ struct DividingLines {
   /// |θ̇m0| below which no recombination occurs within the horizon (null when every θ̇m0 > 0 recombines).
   std::optional<double> threshold;
   std::vector<DividingLinePoint> points;
+  /// Why some points are Unresolved (the search's budget), empty when none is; `threshold` is
+  /// then null (the profile stops short of the horizon).
+  std::string work_limit;
 };
 
 struct TraceOptions {

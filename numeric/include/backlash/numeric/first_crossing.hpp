@@ -43,9 +43,11 @@
 
 #include <Eigen/Dense>
 
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 
 namespace backlash::numeric {
@@ -135,6 +137,11 @@ struct CrossingOptions {
 class SearchBudgetExhausted : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+  SearchBudgetExhausted(const std::string& what, double certified_until)
+      : std::runtime_error(what), certified_until(certified_until) {}
+  /// The search's own guarantee when it stopped: no crossing in (t_begin, certified_until]
+  /// (−∞ when the thrower did not say).
+  double certified_until = -INFINITY;
 };
 
 /// For a witness that starts at zero, w(0) = w'(0) = 0 (a gap leaving a face:
