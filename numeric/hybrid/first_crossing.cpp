@@ -1,7 +1,6 @@
 #include "backlash/numeric/first_crossing.hpp"
 
 #include "hybrid/balancing.hpp"
-#include "hybrid/gap_events.hpp"
 
 #include <boost/container/small_vector.hpp>
 #include <boost/math/tools/roots.hpp>
@@ -190,9 +189,9 @@ bool quadratic_clear(double w0, double w1, double w2, double L, double r) {
 // with s → −s.  No zero in [a, b] when both quadratics keep one sign clear of ρ; w monotone when
 // both lines do.  The curvature is used, so an interval passes at about (|w|/M3)^{1/3}, where
 // the mean-value tests above need |w| > h·M1 with M1 ≳ |w'| + h|w''|.
-bool taylor_excluded(double wa, const Sample& a, double wb, const Sample& b, double h, double M3) {
+bool taylor_excluded(const Sample& a, const Sample& b, double h, double M3) {
   const double L = 0.5 * h, rho = M3 * L * L * L / 6;
-  return same_sign(wa, wb) && quadratic_clear(wa, a.w1, a.w2, L, rho) && quadratic_clear(wb, -b.w1, b.w2, L, rho);
+  return same_sign(a.w, b.w) && quadratic_clear(a.w, a.w1, a.w2, L, rho) && quadratic_clear(b.w, -b.w1, b.w2, L, rho);
 }
 
 bool taylor_monotone(const Sample& a, const Sample& b, double h, double M3) {
@@ -236,10 +235,8 @@ Sample lazy(double t) { return {t, 0, 0, 0, 0, 0}; }
 // K = (w''/2w')² + sup|w'''|/(6|w'|) near t (the cubic term of its error), so the step is taken
 // without a further sample once 2K|δ|³ is below a quarter of the tolerance (time_tolerance
 // relative to max(t, time_unit)), or once |δ| itself is (the witness's rounding then decides).
-double root_in(const Sampler& W, Sample a, Sample b, const CrossingOptions& options, double offset = 0) {
+double root_in(const Sampler& W, const Sample& a, const Sample& b, const CrossingOptions& options) {
   const double tolerance = options.time_tolerance, unit = W.mode().time_unit;
-  a.w += offset;
-  b.w += offset;
   double lo = a.t, hi = b.t;
   const bool rising = a.w < 0;  // w < 0 left of the root when rising
   Sample s = std::fabs(a.w) <= std::fabs(b.w) ? a : b;
@@ -263,65 +260,10 @@ double root_in(const Sampler& W, Sample a, Sample b, const CrossingOptions& opti
       step = mid - s.t;
     }
     s = W.at(s.t + step);
-    s.w += offset;
     if (s.w == 0) return s.t;
     ((s.w < 0) == rising ? lo : hi) = s.t;
   }
   return 0.5 * (lo + hi);
-}
-
-// A second level a search may look for at once (first_crossing_of_two_levels): w − second =
-// (w − level) + offset, active from `from` on (before it the caller knows it has no zero).
-struct SecondLevel {
-  double offset, from;
-};
-
-// A crossing and which level it is of.
-struct LevelCrossing {
-  Crossing crossing;
-  bool second = false;
-};
-
-// What the search does with an interval [a, b] (both ends sampled): on to the next, bisect, or stop
-// at a crossing.
-enum class Step { Next, Bisect, Found };
-struct Decision {
-  Step step;
-  LevelCrossing found{};
-};
-
-// The tests of first_crossing.hpp on [a, b] for the values wa, wb of one level's witness.
-bool excluded_level(double wa, double wb, const Sample& a, const Sample& b, double h, double M1, double M3) {
-  return same_sign(wa, wb) && (std::fabs(wa) + std::fabs(wb) > h * M1 || taylor_excluded(wa, a, wb, b, h, M3));
-}
-
-Decision decide(const Sampler& W, const Sample& a, const Sample& b, double M3, double min_length, const SecondLevel* second,
-                const CrossingOptions& options, long examined) {
-  const double h = b.t - a.t;
-  const double M2 = 0.5 * (std::fabs(a.w2) + std::fabs(b.w2) + h * M3);
-  const double M1 = 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) + h * M2);
-  const double offset = second ? second->offset : 0;
-  const bool active[2] = {true, second && b.t > second->from};
-  bool excluded[2];
-  for (int k = 0; k < 2; ++k)
-    excluded[k] = !active[k] || excluded_level(a.w + k * offset, b.w + k * offset, a, b, h, M1, M3);
-  if (excluded[0] && excluded[1]) return {Step::Next};
-  const bool monotone = same_sign(a.w1, b.w1) &&
-                        (0.5 * (std::fabs(a.w1) + std::fabs(b.w1) - h * M2) > 0 || taylor_monotone(a, b, h, M3));
-  if (!monotone && !(h < min_length)) return {Step::Bisect};
-  std::optional<LevelCrossing> first;
-  for (int k = 0; k < 2; ++k) {
-    const double wa = a.w + k * offset, wb = b.w + k * offset;
-    if (excluded[k] || same_sign(wa, wb)) continue;
-    const double t = wb == 0 ? b.t : root_in(W, a, b, options, k * offset);
-    if (!first || t < first->crossing.t) first = LevelCrossing{Crossing{t, false, examined}, k == 1};
-  }
-  if (first) return {Step::Found, *first};
-  if (monotone) return {Step::Next};  // no root in [a, b]: monotone without a sign change
-  // Uncertified down to the resolution: the witness touches the level here.
-  const int k = excluded[0] ? 1 : 0;
-  const double wa = a.w + k * offset, wb = b.w + k * offset;
-  return {Step::Found, LevelCrossing{Crossing{std::fabs(wa) <= std::fabs(wb) ? a.t : b.t, true, examined}, k == 1}};
 }
 
 // Depth-first, left half first, over windows: the first from t_begin has the mode's own length
@@ -330,13 +272,12 @@ Decision decide(const Sampler& W, const Sample& a, const Sample& b, double M3, d
 // no crossing spends log₂ of the span over the first window on windows).  Within a window the
 // intervals still to examine tile [a, window's end] from the left, so they are kept as their right
 // ends (a stack whose top is the nearest) and the current left end a: an interval decided hands its
-// right end on as the next left end; a halved one pushes its midpoint (an interval across a second
-// level's start, its start).  Inline storage: no allocation unless the bisection goes deeper than
-// 96 levels.  With `clear_until` (certified_clearance: w ≠ 0 on [t_begin, clear_until]) the search
-// starts at clear_until.
-std::optional<LevelCrossing> search(const Sampler& W, const std::function<double(double, double)>* third_derivative_bound,
-                                    double t_begin, double t_end, const CrossingOptions& options,
-                                    double clear_until = -INFINITY, const SecondLevel* second = nullptr) {
+// right end on as the next left end; a halved one pushes its midpoint.  Inline storage: no
+// allocation unless the bisection goes deeper than 96 levels.  With `clear_until`
+// (certified_clearance: w ≠ 0 on [t_begin, clear_until]) the search starts at clear_until.
+std::optional<Crossing> search(const Sampler& W, const std::function<double(double, double)>* third_derivative_bound,
+                               double t_begin, double t_end, const CrossingOptions& options,
+                               double clear_until = -INFINITY) {
   if (clear_until > t_begin) t_begin = std::min(clear_until, t_end);
   if (!(t_end > t_begin)) return std::nullopt;
   const double min_length = options.min_interval * W.mode().time_unit;
@@ -355,40 +296,42 @@ std::optional<LevelCrossing> search(const Sampler& W, const std::function<double
       End& end = ends.back();
       Sample& b = end.s;
       const double h = b.t - a.t;
-      if (second && a.t < second->from && b.t > second->from) {
-        ends.push_back({lazy(second->from), false});
-        continue;
-      }
       const bool halve = !end.known && !third_derivative_bound && std::isfinite(a.w) && W.must_halve(a, h, min_length);
       if (!halve && !end.known) {
         b = W.at(b.t);
         end.known = true;
       }
       if (!std::isfinite(a.w) || (!halve && !std::isfinite(b.w))) throw std::runtime_error("first_crossing: non-finite witness");
-      if (a.w == 0 && a.t > t_begin) return LevelCrossing{Crossing{a.t, false, examined}, false};
-      if (second && a.w + second->offset == 0 && a.t > second->from)
-        return LevelCrossing{Crossing{a.t, false, examined}, true};
+      if (a.w == 0 && a.t > t_begin) return Crossing{a.t, false, examined};
       if (halve) {
         ends.push_back({lazy(a.t + 0.5 * h), false});
         continue;
       }
       const double M3 = third_derivative_bound ? (*third_derivative_bound)(a.t, b.t) : W.third_bound(a, h);
-      const Decision d = decide(W, a, b, M3, min_length, second, options, examined);
-      if (d.step == Step::Found) return d.found;
-      if (d.step == Step::Bisect) {
-        ends.push_back({W.at(a.t + 0.5 * h), true});
+      const double M2 = 0.5 * (std::fabs(a.w2) + std::fabs(b.w2) + h * M3);
+      const double M1 = 0.5 * (std::fabs(a.w1) + std::fabs(b.w1) + h * M2);
+      const bool sign_change = !same_sign(a.w, b.w);
+      const bool excluded =
+          !sign_change && (std::fabs(a.w) + std::fabs(b.w) > h * M1 || taylor_excluded(a, b, h, M3));
+      const bool monotone = !excluded && same_sign(a.w1, b.w1) &&
+                            (0.5 * (std::fabs(a.w1) + std::fabs(b.w1) - h * M2) > 0 || taylor_monotone(a, b, h, M3));
+      if (!excluded && (monotone || h < min_length)) {
+        if (sign_change) {
+          if (b.w == 0) return Crossing{b.t, false, examined};
+          return Crossing{root_in(W, a, b, options), false, examined};
+        }
+        // Uncertified down to the resolution: the witness touches the level here.
+        if (!monotone) return Crossing{std::fabs(a.w) <= std::fabs(b.w) ? a.t : b.t, true, examined};
+      }
+      if (excluded || monotone) {  // no root in [a, b] (monotone without a sign change): on to the next interval
+        a = b;
+        ends.pop_back();
         continue;
       }
-      a = b;
-      ends.pop_back();
+      ends.push_back({W.at(a.t + 0.5 * h), true});
     }
   }
   return std::nullopt;
-}
-
-std::optional<Crossing> crossing_of(const std::optional<LevelCrossing>& c) {
-  if (!c) return std::nullopt;
-  return c->crossing;
 }
 
 // The LinearWitness form as a sampler: x = state(t), value = value(t) or eᵀx.
@@ -487,27 +430,14 @@ std::optional<double> certified_departure(const LinearWitness& witness, double n
 
 std::optional<Crossing> first_crossing(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample, double level,
                                        double t_begin, double t_end, const CrossingOptions& options) {
-  return crossing_of(search(Sampler(mode, sample, level), nullptr, t_begin, t_end, options));
+  return search(Sampler(mode, sample, level), nullptr, t_begin, t_end, options);
 }
 
 std::optional<Crossing> first_crossing_after_departure(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample,
                                                        double t0, double clear_until, double t_end,
                                                        const CrossingOptions& options) {
-  return crossing_of(search(Sampler(mode, sample, 0), nullptr, t0, t_end, options, clear_until));
+  return search(Sampler(mode, sample, 0), nullptr, t0, t_end, options, clear_until);
 }
-
-namespace detail {
-
-std::optional<TwoLevelCrossing> first_crossing_of_two_levels(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample,
-                                                             double level, double second_level, double second_from,
-                                                             double t_end, const CrossingOptions& options) {
-  const SecondLevel second{level - second_level, second_from};
-  const auto c = search(Sampler(mode, sample, level), nullptr, 0, t_end, options, -INFINITY, &second);
-  if (!c) return std::nullopt;
-  return TwoLevelCrossing{c->crossing, c->second};
-}
-
-}  // namespace detail
 
 std::optional<Crossing> first_crossing(const LinearWitness& witness, double t_begin, double t_end,
                                        const CrossingOptions& options) {
@@ -516,7 +446,7 @@ std::optional<Crossing> first_crossing(const LinearWitness& witness, double t_be
   const auto sample = [&witness](double t) { return sample_of(witness, t); };
   const std::function<double(double, double)>* bound =
       witness.third_derivative_bound ? &witness.third_derivative_bound : nullptr;
-  return crossing_of(search(Sampler(mode, sample, witness.level), bound, t_begin, t_end, options));
+  return search(Sampler(mode, sample, witness.level), bound, t_begin, t_end, options);
 }
 
 }  // namespace backlash::numeric

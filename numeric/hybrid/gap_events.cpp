@@ -26,24 +26,20 @@ WitnessMode gap_witness_mode(const LinearSegment& free_segment, double time_unit
   return WitnessMode(free_segment.A, free_segment.c, e, time_unit);
 }
 
-// The opposite face from 0 and the return to the face left from its certified departure t0 (Δx
-// starts as O(t²) or O(t³), below rounding noise at first; certified_clearance keeps it clear of
-// the face beyond t0), in one search of both levels.
 std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
                                         double opposite_face_change, double horizon, double position_scale) {
+  const std::optional<Crossing> opposite = first_crossing(gap_mode, sample, opposite_face_change, 0, horizon);
+  // Return to the face left: Δx starts as O(t²) or O(t³), below rounding noise at first.
+  std::optional<Crossing> back;
   const double noise = 1e-10 * std::max(1.0, position_scale);
   const SmallVector x0 = sample(0).x;
   const std::optional<double> t0 = certified_departure(gap_mode, x0, noise);
-  if (!t0) {
-    const std::optional<Crossing> opposite = first_crossing(gap_mode, sample, opposite_face_change, 0, horizon);
-    if (opposite) return GapEvent{GapEventKind::OppositeFace, *opposite};
-    return std::nullopt;
-  }
-  const double from = std::max(*t0, certified_clearance(gap_mode, x0, *t0, noise));
-  const auto c = first_crossing_of_two_levels(gap_mode, sample, opposite_face_change, 0, from, horizon);
-  if (!c) return std::nullopt;
-  if (c->second) return GapEvent{GapEventKind::FaceLeft, c->crossing, *t0};
-  return GapEvent{GapEventKind::OppositeFace, c->crossing};
+  if (t0)
+    back = first_crossing_after_departure(gap_mode, sample, *t0, certified_clearance(gap_mode, x0, *t0, noise),
+                                          opposite ? opposite->t : horizon);
+  if (back && (!opposite || back->t < opposite->t)) return GapEvent{GapEventKind::FaceLeft, *back, *t0};
+  if (opposite) return GapEvent{GapEventKind::OppositeFace, *opposite};
+  return std::nullopt;
 }
 
 std::optional<GapEvent> first_gap_event_inside(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,

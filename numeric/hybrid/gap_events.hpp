@@ -19,21 +19,6 @@ struct GapEvent {
   bool from_inside = false;  ///< the flight started strictly inside the backlash (no face left, no departure)
 };
 
-/// A crossing of one of two levels, and which (first_crossing_of_two_levels).
-struct TwoLevelCrossing {
-  Crossing crossing;
-  bool second = false;
-};
-
-/// The first crossing of `level` in (0, t_end] or of `second_level` in (second_from, t_end] (the
-/// caller knows w ≠ second_level on (0, second_from]), whichever comes first (at one time, the
-/// first level): first_crossing.hpp's certified search with one tree of samples for both — an
-/// interval is passed over when both levels are excluded on it (the second before second_from)
-/// or w is monotone there without a sign change of either.
-std::optional<TwoLevelCrossing> first_crossing_of_two_levels(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample,
-                                                             double level, double second_level, double second_from,
-                                                             double t_end, const CrossingOptions& options = {});
-
 /// The witness of the gap change Δx = θL − θm − Δx(0) − level of a free flight.
 LinearWitness gap_change_witness(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
                                  std::function<double(double)> gap_change, double level, double time_unit = 1);
