@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <map>
 #include <set>
 #include <thread>
 
@@ -28,6 +29,7 @@ Scores score(const Observations& o, const std::vector<std::vector<double>>& trac
   s.n_fit = fit.size();
   s.n_holdout = held.size();
   s.n = s.n_fit + s.n_holdout;
+  s.robust = robust_sum(fit) + robust_sum(held);
   s.tau_int = o.tau_int;
   double sum = 0;
   for (std::size_t i : o.all_indices) sum += (o.columns[0][i] - traces[0][i]) * (o.columns[0][i] - traces[0][i]);
@@ -369,8 +371,11 @@ std::optional<Trial> best_pair(Search& s, const std::vector<Trial>& singles, dou
     const std::size_t which = static_cast<std::size_t>(std::find(fitted.begin(), fitted.end(), screened[i].single) - fitted.begin());
     screen(screened[i], s, moving[which]);
   });
-  std::vector<const Screened*> chosen;
-  std::set<std::string> seen;
+  // A pair chosen from both of its singles is fitted from both starts (each single's fit with the
+  // other's screened point): Levenberg–Marquardt on a cost with event kinks ends in the valley of
+  // its start, and a single fitted alone is biased by the partner it lacks.
+  std::vector<std::vector<const Screened*>> chosen;
+  std::map<std::string, std::size_t> seen;
   for (std::size_t i = 0; i < std::min(kSingles, fitted.size()); ++i) {
     std::vector<const Screened*> mine;
     for (const Screened& x : screened)
@@ -378,12 +383,15 @@ std::optional<Trial> best_pair(Search& s, const std::vector<Trial>& singles, dou
     std::sort(mine.begin(), mine.end(), [](const Screened* a, const Screened* b) { return a->sse < b->sse; });
     for (std::size_t k = 0; k < std::min<std::size_t>(kPartners, mine.size()); ++k) {
       const std::string a = mine[k]->single->result.effect, b = mine[k]->partner->result.effect;
-      if (seen.insert(std::min(a, b) + " + " + std::max(a, b)).second) chosen.push_back(mine[k]);
+      const auto [at, added] = seen.emplace(std::min(a, b) + " + " + std::max(a, b), chosen.size());
+      if (added) chosen.push_back({mine[k]});
+      else chosen[at->second].push_back(mine[k]);
     }
   }
   for (const Screened& x : screened)  // refused combinations, by name
-    if (!x.problem.empty() && seen.insert(std::min(x.single->result.effect, x.partner->result.effect) + " + " +
-                                          std::max(x.single->result.effect, x.partner->result.effect))
+    if (!x.problem.empty() && seen.emplace(std::min(x.single->result.effect, x.partner->result.effect) + " + " +
+                                               std::max(x.single->result.effect, x.partner->result.effect),
+                                           chosen.size())
                                   .second) {
       Candidate refused;
       refused.effect = x.single->result.effect + " + " + x.partner->result.effect;
@@ -393,10 +401,14 @@ std::optional<Trial> best_pair(Search& s, const std::vector<Trial>& singles, dou
     }
   std::vector<Trial> pairs(chosen.size());
   parallel_for(chosen.size(), s.options.threads, [&](std::size_t i) {
-    pairs[i].candidate = combined({chosen[i]->single->candidate, chosen[i]->partner->candidate});
-    std::vector<double> start = chosen[i]->single->fit.u;
-    start.insert(start.end(), chosen[i]->u.begin(), chosen[i]->u.end());
-    run_trial(pairs[i], s, pairs[i].candidate.effect, departure, &start);
+    for (const Screened* from : chosen[i]) {
+      Trial trial;
+      trial.candidate = combined({from->single->candidate, from->partner->candidate});
+      std::vector<double> start = from->single->fit.u;
+      start.insert(start.end(), from->u.begin(), from->u.end());
+      run_trial(trial, s, trial.candidate.effect, departure, &start);
+      if (from == chosen[i].front() || trial.result.bic < pairs[i].result.bic) pairs[i] = std::move(trial);
+    }
   });
   std::optional<Trial> best;
   for (Trial& pair : pairs) {
@@ -536,7 +548,7 @@ void run_search(Search& s, std::vector<std::string> remaining) {
   auto erase = [&](const std::string& name) { remaining.erase(std::remove(remaining.begin(), remaining.end(), name), remaining.end()); };
   for (const Named& n : s.named) erase(n.result.effect);
   auto go_on = [&](int round) {
-    return round < s.options.max_effects + 2 && s.scores.rms() > at_noise_level(s.o, s.options.noise_level) &&
+    return round < s.options.max_effects + 2 && s.scores.robust_rms() > at_noise_level(s.o, s.options.noise_level) &&
            static_cast<int>(s.named.size()) < s.options.max_effects && !remaining.empty() && !s.simulator.budget_reached();
   };
   for (int rounds = 0; go_on(rounds); ++rounds) {
