@@ -536,66 +536,83 @@ void name_pair(Search& s, const Trial& pair, const std::vector<Trial>& singles) 
   s.current = pair.point;
 }
 
-// The model of everything named but the i-th, at the named values (not refitted).
-ModelPoint without(const Search& s, std::size_t i) {
-  ModelPoint m = s.base;
+// The model of everything named but the i-th, at the named values (not refitted), and the
+// directions in which those others move the residual (directions()).
+std::pair<ModelPoint, Eigen::MatrixXd> without(Search& s, std::size_t i) {
+  std::vector<EffectCandidate> parts;
+  std::vector<double> u;
   for (std::size_t j = 0; j < s.named.size(); ++j) {
     if (j == i) continue;
-    const EffectCandidate& c = s.named[j].candidate;
-    std::vector<double> values;
-    for (std::size_t k = 0; k < c.ranges.size(); ++k) values.push_back(c.ranges[k].value(coordinate_of(c, s.named[j].result.parameters, k, s.base)));
-    m = c.apply(m, values);
+    parts.push_back(s.named[j].candidate);
+    for (std::size_t k = 0; k < s.named[j].candidate.ranges.size(); ++k)
+      u.push_back(coordinate_of(s.named[j].candidate, s.named[j].result.parameters, k, s.base));
   }
-  return m;
+  if (parts.empty()) return {s.base, Eigen::MatrixXd()};
+  const EffectCandidate others = combined(parts);
+  std::vector<double> values;
+  for (std::size_t k = 0; k < u.size(); ++k) values.push_back(others.ranges[k].value(u[k]));
+  return {others.apply(s.base, values), directions(s, others, s.base, u)};
 }
+
+// The named candidates with the i-th replaced by the parameter `name` (from u), refitted together.
+std::optional<std::pair<std::vector<Named>, ModelPoint>> swapped_for(Search& s, std::size_t i, const std::string& name, double u) {
+  std::vector<Named> swapped = s.named;
+  Named& y = swapped[i];
+  y.candidate = candidate_for(name, s.base, s.step);
+  y.result = Candidate{};
+  y.result.effect = name;
+  y.result.parameters = {{y.candidate.ranges[0].name, y.candidate.ranges[0].value(u), NAN}};
+  const auto point = joint_refit(s, swapped);
+  if (!point) return std::nullopt;
+  return std::make_pair(std::move(swapped), *point);
+}
+
+/// The parameters tried in a named correction's place (the best of their scans).
+constexpr std::size_t kSwaps = 2;
 
 // A named parameter correction swapped for another (docs/discrepancy.md, "The search"): K and
 // motor.J both move the servo's frequency, and beside a delay fitted from a biased start K can be
-// named where motor.J is wrong (ΔBIC −15638, 5.9σ left).  Each other parameter is scanned with the
-// correction taken out, the best refitted with everything else named; it replaces the correction
-// when decisively better, and within ambiguity_bic the two are alike (the status ambiguous).
-// Returns the parameter named in its place, or "".
+// named where motor.J is wrong (ΔBIC −15638, 5.9σ left).  Every other parameter is scanned with
+// the correction taken out (the rest named moving with it, to first order), the best kSwaps are
+// refitted with everything else named; the best replaces the correction when decisively better,
+// and within ambiguity_bic the two are alike (the status ambiguous).  Returns the parameter named
+// in its place, or "".
 std::string swap_correction(Search& s, const std::vector<std::string>& remaining) {
   const int k = s.parameters();
   for (std::size_t i = 0; i < s.named.size(); ++i) {
     if (!is_parameter_correction(s.named[i].result.effect) || s.named[i].candidate.ranges.size() != 1) continue;
-    const ModelPoint at = without(s, i);
-    std::string best_name;
-    std::vector<double> best_u;
-    double best_sse = INFINITY;
+    const auto [at, moving] = without(s, i);
+    std::vector<std::pair<double, std::pair<std::string, double>>> ranked;
     for (const std::string& name : remaining) {
       if (!is_parameter_correction(name) || name == "backlash_size" || s.simulator.budget_reached()) continue;
       try {
         std::vector<double> u;
-        const double sse = best_scan_point(s, candidate_for(name, at, s.step), at, Eigen::MatrixXd(), u);
-        if (sse < best_sse) best_sse = sse, best_name = name, best_u = u;
+        const double sse = best_scan_point(s, candidate_for(name, at, s.step), at, moving, u);
+        if (std::isfinite(sse)) ranked.push_back({sse, {name, u[0]}});
       } catch (const std::exception&) {  // a parameter at 0 is no candidate
       }
     }
-    if (best_name.empty()) continue;
-    std::vector<Named> swapped = s.named;
-    Named& y = swapped[i];
-    y.candidate = candidate_for(best_name, s.base, s.step);
-    y.result = Candidate{};
-    y.result.effect = best_name;
-    y.result.parameters = {{y.candidate.ranges[0].name, y.candidate.ranges[0].value(best_u[0]), NAN}};
-    const auto point = joint_refit(s, swapped);
-    if (!point) continue;
-    const auto traces = s.simulator.traces(*point, s.o.size());
-    if (!traces) continue;
-    const Scores scores = score(s.o, *traces);
-    const double delta = scores.bic(k) - s.scores.bic(k);
-    if (std::fabs(delta) < s.options.ambiguity_bic) {
-      if (s.alike.empty()) s.alike.push_back(s.named[i].result);
-      s.alike.push_back(y.result);
-      if (s.experiment.empty()) s.experiment = experiment_between(s.named[i].result.effect, best_name);
+    std::sort(ranked.begin(), ranked.end());
+    for (std::size_t r = 0; r < std::min(kSwaps, ranked.size()); ++r) {
+      const std::string& name = ranked[r].second.first;
+      auto swapped = swapped_for(s, i, name, ranked[r].second.second);
+      const auto traces = swapped ? s.simulator.traces(swapped->second, s.o.size()) : std::nullopt;
+      if (!traces) continue;
+      const Scores scores = score(s.o, *traces);
+      const double delta = scores.bic(k) - s.scores.bic(k);
+      Candidate& y = swapped->first[i].result;
+      if (std::fabs(delta) < s.options.ambiguity_bic) {
+        if (s.alike.empty()) s.alike.push_back(s.named[i].result);
+        s.alike.push_back(y);
+        if (s.experiment.empty()) s.experiment = experiment_between(s.named[i].result.effect, name);
+      }
+      if (delta >= -s.options.decisive_bic) continue;
+      y.decisive = true, y.delta_bic = delta;
+      s.named = std::move(swapped->first);
+      s.current = swapped->second;
+      s.scores = scores;
+      return name;
     }
-    if (delta >= -s.options.decisive_bic) continue;
-    y.result.decisive = true, y.result.delta_bic = delta;
-    s.named = std::move(swapped);
-    s.current = *point;
-    s.scores = scores;
-    return best_name;
   }
   return "";
 }
