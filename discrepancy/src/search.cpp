@@ -574,9 +574,9 @@ constexpr std::size_t kSwaps = 2;
 // motor.J both move the servo's frequency, and beside a delay fitted from a biased start K can be
 // named where motor.J is wrong (ΔBIC −15638, 5.9σ left).  Every other parameter is scanned with
 // the correction taken out (the rest named moving with it, to first order), the best kSwaps are
-// refitted with everything else named; the best replaces the correction when decisively better,
-// and within ambiguity_bic the two are alike (the status ambiguous).  Returns the parameter named
-// in its place, or "".
+// refitted with everything else named; the best replaces the correction when decisively better
+// and the model then meets the record at the noise level; within ambiguity_bic the two are alike
+// (the status ambiguous).  Returns the parameter named in its place, or "".
 std::string swap_correction(Search& s, const std::vector<std::string>& remaining) {
   const int k = s.parameters();
   for (std::size_t i = 0; i < s.named.size(); ++i) {
@@ -606,7 +606,10 @@ std::string swap_correction(Search& s, const std::vector<std::string>& remaining
         s.alike.push_back(y);
         if (s.experiment.empty()) s.experiment = experiment_between(s.named[i].result.effect, name);
       }
-      if (delta >= -s.options.decisive_bic) continue;
+      // Only a swap that closes the gap: a greedy swap that merely improves can block the round
+      // that would have dropped the correction as needless (a backlash change named beside
+      // Coulomb friction on the load, where a torque offset is missing, swapped for the reference).
+      if (delta >= -s.options.decisive_bic || scores.robust_rms() > at_noise_level(s.o, s.options.noise_level)) continue;
       y.decisive = true, y.delta_bic = delta;
       s.named = std::move(swapped->first);
       s.current = swapped->second;
