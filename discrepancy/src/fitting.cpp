@@ -27,7 +27,12 @@ Simulator::Simulator(const Observations& data, double step, double t_end, double
 
 void Simulator::prepare(const std::vector<ModelPoint>& points) {
   std::vector<std::pair<numeric::Parameters, numeric::Effects>> samples;
-  for (const ModelPoint& m : points) samples.push_back({m.p, m.e});
+  // A point inside a box its structure already passed at is not validated again (its sample
+  // would not grow the box): every fit prepares its candidate's corners, a joint refit of four
+  // parameters sixteen of them, each validated against the odeint reference — most of a search's
+  // time when repeated (half of a record's CPU seconds, perf, in odeint's dopri5).
+  for (const ModelPoint& m : points)
+    if (!family_.at(m.p, m.e)) samples.push_back({m.p, m.e});
   family_.validate_samples(samples);
 }
 
@@ -357,6 +362,17 @@ std::vector<std::vector<double>> scan_starts(const Objective& objective, const E
 
 }  // namespace
 
+void prepare_candidate(Simulator& simulator, const EffectCandidate& c, const ModelPoint& base) {
+  std::vector<ModelPoint> corners;
+  const std::size_t k = c.ranges.size();
+  for (int mask = 0; mask < (1 << k); ++mask) {
+    std::vector<double> values;
+    for (std::size_t i = 0; i < k; ++i) values.push_back(c.ranges[i].value((mask >> i) & 1 ? 1.0 : 0.0));
+    corners.push_back(c.apply(base, values));
+  }
+  simulator.prepare(corners);
+}
+
 // The fit grows its horizon: scanned and refined up to a quarter servo period past the base
 // model's first departure from the record (where the response still depends smoothly on the
 // parameter — over a long record a lively gear's response, say with a high restitution, is
@@ -368,15 +384,8 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
   std::atomic<int> calls{0};
   std::atomic<long> work{0}, weighted{0};
   const std::vector<std::size_t>& samples = whole_record ? data.all_indices : data.fit_indices;
-  // The family validated over the candidate's whole range (its corners).
-  std::vector<ModelPoint> corners;
   const std::size_t k = c.ranges.size();
-  for (int mask = 0; mask < (1 << k); ++mask) {
-    std::vector<double> values;
-    for (std::size_t i = 0; i < k; ++i) values.push_back(c.ranges[i].value((mask >> i) & 1 ? 1.0 : 0.0));
-    corners.push_back(c.apply(base, values));
-  }
-  simulator.prepare(corners);
+  prepare_candidate(simulator, c, base);
   // The robust loss's scale: Huber's at kHuberScale times the scale of the residual where the fit
   // starts (its start, or the base model) — an M-estimate with a preliminary scale: at the noise
   // level the noise's σ (a spike is an outlier), over a systematic gap the gap's size (a gap the

@@ -144,6 +144,11 @@ struct Fit {
   bool budget_exhausted = false;  ///< the fit stopped at its work budget (its best point is kept)
 };
 
+/// The family validated over a candidate's whole range added to `base` (its corners): the points
+/// within are then simulated without a validation each (Simulator::simulate validates a point
+/// outside every validated box against the odeint reference — 20–50 closed-form simulations' time).
+void prepare_candidate(Simulator& simulator, const EffectCandidate& c, const ModelPoint& base);
+
 /// Fits a candidate added to `base`: the scan, then Ceres from the best points.  With
 /// `whole_record` the fit uses every sample and the covariance is computed.
 /// The fit stops when its work (1000 per simulation plus the events simulated) reaches `budget`

@@ -223,6 +223,7 @@ double best_scan_point(Search& s, const EffectCandidate& c, const ModelPoint& at
                        std::vector<double>& best_u) {
   double best = INFINITY;
   long work = 0;
+  prepare_candidate(s.simulator, c, at);  // else every scan point outside the box is validated alone
   for (const std::vector<double>& u : c.scan()) {
     if (s.simulator.budget_reached() || work >= s.options.candidate_work / 4) break;
     std::vector<double> values;
