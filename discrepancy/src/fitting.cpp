@@ -27,7 +27,12 @@ Simulator::Simulator(const Observations& data, double step, double t_end, double
 
 void Simulator::prepare(const std::vector<ModelPoint>& points) {
   std::vector<std::pair<numeric::Parameters, numeric::Effects>> samples;
-  for (const ModelPoint& m : points) samples.push_back({m.p, m.e});
+  // A point inside a box its structure already passed at is not validated again (its sample
+  // would not grow the box): every fit prepares its candidate's corners, a joint refit of four
+  // parameters sixteen of them, each validated against the odeint reference — most of a search's
+  // time when repeated (half of a record's CPU seconds, perf, in odeint's dopri5).
+  for (const ModelPoint& m : points)
+    if (!family_.at(m.p, m.e)) samples.push_back({m.p, m.e});
   family_.validate_samples(samples);
 }
 
@@ -163,20 +168,28 @@ double sum_of_squares(const std::vector<double>& r) {
 }
 
 namespace {
-double huber_rho(double r) {
-  // ceres::HuberLoss's ρ(s) of s = r²: s inside the scale, 2c|r| − c² beyond (a residual of
-  // 20σ counts 111 instead of 400).
-  static const ceres::HuberLoss loss(kHuberScale);
+double huber_rho(double r, double scale) {
+  // ceres::HuberLoss's ρ(s) of s = r²: s inside the scale a, 2a|r| − a² beyond (at a = 3, a
+  // residual of 20σ counts 111 instead of 400).
+  const ceres::HuberLoss loss(kHuberScale * scale);
   double rho[3];
   loss.Evaluate(r * r, rho);
   return rho[0];
 }
 }  // namespace
 
-double robust_sum(const std::vector<double>& r) {
+double robust_sum(const std::vector<double>& r, double scale) {
   double sum = 0;
-  for (double x : r) sum += huber_rho(x);
+  for (double x : r) sum += huber_rho(x, scale);
   return sum;
+}
+
+double residual_scale(const std::vector<double>& r) {
+  if (r.empty()) return 1;
+  std::vector<double> size(r.size());
+  std::transform(r.begin(), r.end(), size.begin(), [](double x) { return std::fabs(x); });
+  std::nth_element(size.begin(), size.begin() + static_cast<std::ptrdiff_t>(size.size() / 2), size.end());
+  return std::max(1.0, 1.4826 * size[size.size() / 2]);
 }
 
 // ------------------------------------------------------------------ the fit
@@ -202,6 +215,7 @@ struct Objective {
   std::atomic<long>& work;  ///< work of this fit: 1000 per simulation plus its events
   std::atomic<long>& weighted;  ///< its cost as the search counts it (Simulator::cost): at most 4 budgets
   long budget;              ///< past it, no further simulation (deterministic, unlike a clock)
+  double loss_scale = 1;    ///< the robust loss's scale, in σ (residual_scale() at the fit's start)
 
   ModelPoint point(const double* u) const {
     std::vector<double> values;
@@ -230,7 +244,8 @@ struct CostFunctor {
     // Each residual through Huber's ρ on its own (sgn r·√ρ(r²)): the sum of squares Ceres
     // minimises is robust_sum().  (A loss function on the residual block would act on the
     // block's whole squared norm, Σ r², and robustify nothing.)
-    std::transform(r->begin(), r->end(), out, [](double x) { return std::copysign(std::sqrt(huber_rho(x)), x); });
+    const double scale = objective->loss_scale;
+    std::transform(r->begin(), r->end(), out, [scale](double x) { return std::copysign(std::sqrt(huber_rho(x, scale)), x); });
     return true;
   }
 };
@@ -308,7 +323,7 @@ Solved brent(const Objective& objective, double start, double cell) {
   auto sse = [&](double x) {
     const double at[1] = {x};
     const auto r = objective.residuals_at(at);
-    return r ? robust_sum(*r) : INFINITY;
+    return r ? robust_sum(*r, objective.loss_scale) : INFINITY;
   };
   const double lo = std::max(0.0, start - cell), hi = std::min(1.0, start + cell);
   constexpr int points = 11;
@@ -330,7 +345,7 @@ std::vector<std::vector<double>> scan_starts(const Objective& objective, const E
   std::vector<std::pair<double, std::vector<double>>> scored;
   for (const std::vector<double>& u : c.scan()) {
     const auto r = objective.residuals_at(u.data());
-    if (r) scored.push_back({robust_sum(*r), u});
+    if (r) scored.push_back({robust_sum(*r, objective.loss_scale), u});
   }
   std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   std::vector<std::vector<double>> starts;
@@ -347,6 +362,17 @@ std::vector<std::vector<double>> scan_starts(const Objective& objective, const E
 
 }  // namespace
 
+void prepare_candidate(Simulator& simulator, const EffectCandidate& c, const ModelPoint& base) {
+  std::vector<ModelPoint> corners;
+  const std::size_t k = c.ranges.size();
+  for (int mask = 0; mask < (1 << k); ++mask) {
+    std::vector<double> values;
+    for (std::size_t i = 0; i < k; ++i) values.push_back(c.ranges[i].value((mask >> i) & 1 ? 1.0 : 0.0));
+    corners.push_back(c.apply(base, values));
+  }
+  simulator.prepare(corners);
+}
+
 // The fit grows its horizon: scanned and refined up to a quarter servo period past the base
 // model's first departure from the record (where the response still depends smoothly on the
 // parameter — over a long record a lively gear's response, say with a high restitution, is
@@ -358,15 +384,22 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
   std::atomic<int> calls{0};
   std::atomic<long> work{0}, weighted{0};
   const std::vector<std::size_t>& samples = whole_record ? data.all_indices : data.fit_indices;
-  // The family validated over the candidate's whole range (its corners).
-  std::vector<ModelPoint> corners;
   const std::size_t k = c.ranges.size();
-  for (int mask = 0; mask < (1 << k); ++mask) {
-    std::vector<double> values;
-    for (std::size_t i = 0; i < k; ++i) values.push_back(c.ranges[i].value((mask >> i) & 1 ? 1.0 : 0.0));
-    corners.push_back(c.apply(base, values));
+  prepare_candidate(simulator, c, base);
+  // The robust loss's scale: Huber's at kHuberScale times the scale of the residual where the fit
+  // starts (its start, or the base model) — an M-estimate with a preliminary scale: at the noise
+  // level the noise's σ (a spike is an outlier), over a systematic gap the gap's size (a gap the
+  // model does not yet explain is no outlier: the fit then minimises the sum of squares its score is).
+  double loss_scale = 1;
+  {
+    ModelPoint from = base;
+    if (start_u) {
+      std::vector<double> values;
+      for (std::size_t i = 0; i < k; ++i) values.push_back(c.ranges[i].value((*start_u)[i]));
+      from = c.apply(base, values);
+    }
+    if (const auto traces = simulator.traces(from, samples.back() + 1)) loss_scale = residual_scale(residuals(data, *traces, samples));
   }
-  simulator.prepare(corners);
   // The horizons: from a quarter servo period past where the base model first leaves the noise
   // band (the first events that tell the parameter apart), growing by half each stage.
   const double t0 = data.t.front(), t_end = data.t.back();
@@ -381,7 +414,7 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
     for (; h < t_end; h = t0 + 1.5 * (h - t0)) horizons.push_back(h);
     horizons.push_back(t_end);
     const std::vector<std::size_t> first_samples = prefix(data, samples, horizons.front());
-    starts = scan_starts(Objective{simulator, data, base, c, first_samples, calls, work, weighted, budget}, c);
+    starts = scan_starts(Objective{simulator, data, base, c, first_samples, calls, work, weighted, budget, loss_scale}, c);
   }
   // One parameter: the best two distinct valleys are followed from stage to stage (a valley
   // that looks best on a short horizon can lose on a longer one).
@@ -389,7 +422,7 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
   double cell = start_u ? 0.02 : 1.0 / 39;  // one parameter: Brent's bracket, narrowing as the horizon grows
   for (std::size_t stage = 0; stage < horizons.size(); ++stage, cell = std::max(0.004, 0.6 * cell)) {
     const std::vector<std::size_t> stage_samples = prefix(data, samples, horizons[stage]);
-    const Objective objective{simulator, data, base, c, stage_samples, calls, work, weighted, budget};
+    const Objective objective{simulator, data, base, c, stage_samples, calls, work, weighted, budget, loss_scale};
     std::vector<Solved> found;
     for (const std::vector<double>& u : starts) {
       Solved s = k == 1 ? brent(objective, u[0], cell) : solve(objective, u, false, 25);

@@ -318,8 +318,10 @@ NoiseFit reestimate_noise(Observations& o, const std::vector<std::vector<double>
 namespace {
 
 // The result's traces, features, regions and gaps, from the nominal and the corrected model.
+// `robust_gap_after`: the corrected model's gap as the noise-level test reads it (Scores::robust_rms).
 void describe(DiscrepancyResult& result, Simulator& simulator, const Observations& o, const ModelPoint& nominal,
-              const ModelPoint& current, const std::vector<std::vector<double>>& nominal_traces, double step) {
+              const ModelPoint& current, const std::vector<std::vector<double>>& nominal_traces, double step,
+              double& robust_gap_after) {
   std::vector<numeric::SimulationEvent> corrected_events;
   const auto corrected = simulator.traces(current, o.size(), &corrected_events);
   result.theta_corrected = corrected ? (*corrected)[0] : result.theta_nominal;
@@ -329,6 +331,7 @@ void describe(DiscrepancyResult& result, Simulator& simulator, const Observation
   result.gap_before = before.rms();
   result.rms_after = corrected ? detail::score(o, *corrected).rms_theta_out : result.rms_before;
   result.gap_after = corrected ? detail::score(o, *corrected).rms() : result.gap_before;
+  robust_gap_after = corrected ? detail::score(o, *corrected).robust_rms() : before.robust_rms();
   result.first_departure = detail::first_departure(o, result.theta_nominal);
   result.remaining_departure = detail::first_departure(o, result.theta_corrected);
   result.parameters = current.p;
@@ -360,7 +363,7 @@ DiscrepancyResult find_discrepancy(const model::CaseSpec& spec, const measuremen
   simulator.set_budget(options.total_work);
   detail::Search s{simulator, o, nominal, step, options, nominal, {}, {}, {}, {}, {}};
   s.rescore();
-  const bool nominal_at_noise = s.scores.rms() <= detail::at_noise_level(o, options.noise_level);
+  const bool nominal_at_noise = s.scores.robust_rms() <= detail::at_noise_level(o, options.noise_level);
   detail::fit_free_parameters(s, free);
   detail::run_search(s, names);
   if (simulator.budget_reached())
@@ -375,7 +378,8 @@ DiscrepancyResult find_discrepancy(const model::CaseSpec& spec, const measuremen
   result.t = o.t;
   result.theta_measured = o.columns[0];
   result.theta_nominal = (*nominal_traces)[0];
-  describe(result, simulator, o, nominal, s.current, *nominal_traces, step);
+  double robust_gap_after = 0;
+  describe(result, simulator, o, nominal, s.current, *nominal_traces, step, robust_gap_after);
   result.outliers = outliers_of(o, *nominal_traces);
   for (const detail::Named& n : s.named)
     if (!is_parameter_correction(n.result.effect) || n.result.effect == "backlash_size") result.effects.push_back(n.result);
@@ -383,7 +387,7 @@ DiscrepancyResult find_discrepancy(const model::CaseSpec& spec, const measuremen
   result.rounds = s.rounds;
   result.alternatives = s.alike;
   result.distinguishing_experiment = s.experiment;
-  result.status = status_of(s, result.gap_after <= result.noise_estimate.at_noise, nominal_at_noise);
+  result.status = status_of(s, robust_gap_after <= result.noise_estimate.at_noise, nominal_at_noise);
   result.simulations = simulator.simulations();
   result.work = simulator.work();
   if (std::getenv("BACKLASH_DEBUG_FITS"))
