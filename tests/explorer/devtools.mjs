@@ -1,6 +1,6 @@
 // devtools.mjs — a small client of headless Chromium's DevTools protocol over a pipe, with no npm
 // package: Chromium started with --remote-debugging-pipe reads NUL-terminated JSON commands on
-// fd 3 and answers on fd 4.  Used by the browser test (run_in_chromium.mjs) and the redraw
+// fd 3 and answers on fd 4.  Used by the browser tests (*_in_chromium.mjs) and the redraw
 // benchmark (bench/explorer_redraw.sh).
 import { spawn, execFileSync } from "node:child_process";
 import fs from "node:fs";
@@ -12,6 +12,51 @@ export function findChromium() {
   return ["chromium", "chromium-browser", "google-chrome"].map((name) => {
     try { return execFileSync("sh", ["-c", `command -v ${name}`]).toString().trim(); } catch { return ""; }
   }).find((p) => p) || "";
+}
+
+/// A browser test's Chromium: the system's, or the process exits 77 (ctest SKIP_RETURN_CODE) with
+/// the reason when none is installed or the build makes no page (`built` = "not-built"), and 1
+/// when the page should exist and does not.
+export function chromiumForTest(page, built) {
+  const chromium = findChromium();
+  if (!chromium) { console.log("SKIP: no Chromium installed (apt-get install chromium; scripts/install-deps.sh)"); process.exit(77); }
+  if (built === "not-built") {
+    console.log("SKIP: this build makes no explorer page (no emcc — apt-get install emscripten — or a sanitizer build)");
+    process.exit(77);
+  }
+  if (!fs.existsSync(page)) { console.log(`FAIL: the explorer page ${page} is missing`); process.exit(1); }
+  return chromium;
+}
+
+/// A test's checks: check(what, ok, detail) prints one "ok"/"FAIL" line; finish() prints the
+/// count of failed checks and exits 1 when any failed, else 0.
+export function checks() {
+  const failures = [];
+  return {
+    check(what, ok, detail) {
+      console.log(`${ok ? "ok  " : "FAIL"} ${what}${detail ? ": " + detail : ""}`);
+      if (!ok) failures.push(what);
+    },
+    finish() {
+      console.log(failures.length ? `${failures.length} check(s) failed` : "all checks passed");
+      process.exit(failures.length ? 1 : 0);
+    },
+  };
+}
+
+/// The page's dividing-line points of θ̇m0 > 0 against `trace FILE --json`'s points: `same` when
+/// both list the same θ̇m0 with the same statuses (and, with `decided`, none is work_limit and
+/// the list is not empty); `worst` the largest difference of the states relative to max(1, |x|).
+export function compareDividingLines(pagePoints, tracePoints, decided = false) {
+  const mine = pagePoints.filter((q) => q.v0 > 0);
+  let worst = 0, same = mine.length === tracePoints.length && (!decided || tracePoints.length > 0);
+  for (let i = 0; same && i < tracePoints.length; i++) {
+    const t = tracePoints[i];
+    same = mine[i].v0 === t.v0 && mine[i].status === t.status && !(decided && t.status === "work_limit");
+    for (const k of ["t", "theta_m", "dtheta_m", "theta_L", "dtheta_L", "theta_o", "dtheta_o"])
+      if (same && t[k] !== null) worst = Math.max(worst, Math.abs(mine[i][k] - t[k]) / Math.max(1, Math.abs(t[k])));
+  }
+  return { count: mine.length, same, worst };
 }
 
 /// Starts headless Chromium and opens one page (a 1400×900 window); returns { cdp, evaluate,

@@ -21,24 +21,12 @@ import { execFileSync } from "node:child_process";
 import fs from "node:fs";
 import os from "node:os";
 import path from "node:path";
-import { findChromium, openBrowser } from "./devtools.mjs";
+import { chromiumForTest, checks, openBrowser } from "./devtools.mjs";
 
 const [page, cli, artifacts, built = "built"] = process.argv.slice(2);
-const SKIP = 77;
-const chromium = findChromium();
-if (!chromium) { console.log("SKIP: no Chromium installed (apt-get install chromium; scripts/install-deps.sh)"); process.exit(SKIP); }
-if (built === "not-built") {
-  console.log("SKIP: this build makes no explorer page (no emcc — apt-get install emscripten — or a sanitizer build)");
-  process.exit(SKIP);
-}
-if (!fs.existsSync(page)) { console.log(`FAIL: the explorer page ${page} is missing`); process.exit(1); }
+const chromium = chromiumForTest(page, built);
 fs.mkdirSync(artifacts, { recursive: true });
-
-const failures = [];
-function check(what, ok, detail) {
-  console.log(`${ok ? "ok  " : "FAIL"} ${what}${detail ? ": " + detail : ""}`);
-  if (!ok) failures.push(what);
-}
+const { check, finish } = checks();
 
 const b = await openBrowser(chromium);
 const watchdog = setTimeout(() => { console.log("FAIL: the browser test ran over 150 s\n" + b.stderr().slice(-2000)); b.close(); process.exit(1); }, 150000);
@@ -249,5 +237,4 @@ try {
 clearTimeout(watchdog);
 b.close();
 if (!process.env.KEEP_DOWNLOADS) fs.rmSync(downloads, { recursive: true, force: true });
-console.log(failures.length ? `${failures.length} check(s) failed` : "all checks passed");
-process.exit(failures.length ? 1 : 0);
+finish();

@@ -20,19 +20,11 @@ import { execFileSync } from "node:child_process";
 import fs from "node:fs";
 import os from "node:os";
 import path from "node:path";
-import { findChromium, openBrowser } from "./devtools.mjs";
+import { chromiumForTest, checks, compareDividingLines, openBrowser } from "./devtools.mjs";
 
 const [page, cli, built = "built"] = process.argv.slice(2);
-const chromium = findChromium();
-if (!chromium) { console.log("SKIP: no Chromium installed (apt-get install chromium; scripts/install-deps.sh)"); process.exit(77); }
-if (built === "not-built") { console.log("SKIP: this build makes no explorer page (no emcc, or a sanitizer build)"); process.exit(77); }
-if (!fs.existsSync(page)) { console.log(`FAIL: the explorer page ${page} is missing`); process.exit(1); }
-
-const failures = [];
-function check(what, ok, detail) {
-  console.log(`${ok ? "ok  " : "FAIL"} ${what}${detail ? ": " + detail : ""}`);
-  if (!ok) failures.push(what);
-}
+const chromium = chromiumForTest(page, built);
+const { check, finish } = checks();
 const close = (a, b) => Math.abs(a - b) <= 1e-12 * Math.max(1, Math.abs(b));
 const folder = fs.mkdtempSync(path.join(os.tmpdir(), "explorer-drag-"));
 const b = await openBrowser(chromium);
@@ -92,15 +84,9 @@ async function scenario(id, name, values) {
   const differ = sameDocument(r.cycle, cycle, ["case"]);
   check(`${label}: the limit cycle equals \`limit-cycle FILE --json\` at the final value (status, reason, numbers to 1e-12)`, differ.length === 0,
     `status ${r.cycle.status}, peak-to-peak page ${r.cycle.peak_to_peak}, CLI ${cycle.peak_to_peak}${differ.length ? "; " + differ.join("; ").slice(0, 400) : ""}`);
-  const trace = backlash("trace").points, mine = r.points.filter((q) => q.v0 > 0);
-  let worst = 0, same = mine.length === trace.length;
-  for (let i = 0; same && i < trace.length; i++) {
-    same = mine[i].v0 === trace[i].v0 && mine[i].status === trace[i].status;
-    for (const k of ["t", "theta_m", "dtheta_m", "theta_L", "dtheta_L", "theta_o", "dtheta_o"])
-      if (same && trace[i][k] !== null) worst = Math.max(worst, Math.abs(mine[i][k] - trace[i][k]) / Math.max(1, Math.abs(trace[i][k])));
-  }
+  const { count, same, worst } = compareDividingLines(r.points, backlash("trace").points);
   check(`${label}: the dividing lines (θ̇m0 > 0) equal \`trace FILE --json\` at the final value, to 1e-12`, same && worst <= 1e-12,
-    `${mine.length} points, statuses ${same ? "equal" : "differ"}, largest relative difference ${worst}`);
+    `${count} points, statuses ${same ? "equal" : "differ"}, largest relative difference ${worst}`);
   const run = r.run, sim = backlash("simulate", "--from", `${run.start.theta_o},${run.start.dtheta_o}`, "--t-end", String(run.t_end));
   let worstEvent = 0, kinds = run.events.length === sim.events.length;
   for (let i = 0; kinds && i < sim.events.length; i++) {
@@ -124,5 +110,4 @@ try {
   b.close();
   fs.rmSync(folder, { recursive: true, force: true });
 }
-console.log(failures.length ? `${failures.length} check(s) failed` : "all checks passed");
-process.exit(failures.length ? 1 : 0);
+finish();

@@ -13,19 +13,11 @@ import { execFileSync } from "node:child_process";
 import fs from "node:fs";
 import os from "node:os";
 import path from "node:path";
-import { findChromium, openBrowser } from "./devtools.mjs";
+import { chromiumForTest, checks, compareDividingLines, openBrowser } from "./devtools.mjs";
 
 const [page, cli, built = "built"] = process.argv.slice(2);
-const chromium = findChromium();
-if (!chromium) { console.log("SKIP: no Chromium installed (apt-get install chromium; scripts/install-deps.sh)"); process.exit(77); }
-if (built === "not-built") { console.log("SKIP: this build makes no explorer page (no emcc, or a sanitizer build)"); process.exit(77); }
-if (!fs.existsSync(page)) { console.log(`FAIL: the explorer page ${page} is missing`); process.exit(1); }
-
-const failures = [];
-function check(what, ok, detail) {
-  console.log(`${ok ? "ok  " : "FAIL"} ${what}${detail ? ": " + detail : ""}`);
-  if (!ok) failures.push(what);
-}
+const chromium = chromiumForTest(page, built);
+const { check, finish } = checks();
 const folder = fs.mkdtempSync(path.join(os.tmpdir(), "explorer-trace20-"));
 const b = await openBrowser(chromium);
 const watchdog = setTimeout(() => { console.log("FAIL: the test ran over 100 s"); b.close(); process.exit(1); }, 100000);
@@ -47,15 +39,10 @@ async function scenario(item, id, name, values) {
     `field ${r.field}${r.bad ? ", status: " + r.status : ""}`);
   const file = path.join(folder, `${id}_${name}.toml`);
   fs.writeFileSync(file, r.caseFile);
-  const trace = JSON.parse(execFileSync(cli, ["trace", file, "--json"]).toString()).points, mine = r.points.filter((q) => q.v0 > 0);
-  let worst = 0, same = !r.bad && mine.length === trace.length && trace.length > 0;  // not the last valid frame's
-  for (let i = 0; same && i < trace.length; i++) {
-    same = mine[i].v0 === trace[i].v0 && mine[i].status === trace[i].status && trace[i].status !== "work_limit";
-    for (const k of ["t", "theta_m", "dtheta_m", "theta_L", "dtheta_L", "theta_o", "dtheta_o"])
-      if (same && trace[i][k] !== null) worst = Math.max(worst, Math.abs(mine[i][k] - trace[i][k]) / Math.max(1, Math.abs(trace[i][k])));
-  }
-  check(`${label}: the dividing lines (θ̇m0 > 0) equal \`trace FILE --json\`, every point decided, to 1e-12`, same && worst <= 1e-12,
-    `${mine.length} points, statuses ${same ? "equal" : "differ or undecided"}, largest relative difference ${worst}`);
+  const trace = JSON.parse(execFileSync(cli, ["trace", file, "--json"]).toString()).points;
+  const c = compareDividingLines(r.points, trace, true), same = !r.bad && c.same;  // not the last valid frame's
+  check(`${label}: the dividing lines (θ̇m0 > 0) equal \`trace FILE --json\`, every point decided, to 1e-12`, same && c.worst <= 1e-12,
+    `${c.count} points, statuses ${same ? "equal" : "differ or undecided"}, largest relative difference ${c.worst}`);
 }
 
 try {
@@ -71,5 +58,4 @@ try {
   b.close();
   fs.rmSync(folder, { recursive: true, force: true });
 }
-console.log(failures.length ? `${failures.length} check(s) failed` : "all checks passed");
-process.exit(failures.length ? 1 : 0);
+finish();
