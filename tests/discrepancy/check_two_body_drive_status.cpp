@@ -53,14 +53,6 @@ fs::path folder() {
   return p;
 }
 
-TwoBodyRecordSpec spec_of(double backlash) {
-  TwoBodyRecordSpec spec;
-  spec.plant.backlash = backlash;
-  spec.reference.amplitude = 0.8;
-  spec.current_noise = 0.002;
-  return spec;
-}
-
 // The workflow's JSON on a record (optionally changed before it is written) against the truth
 // with the backlash 1.4× and the load's inertia 1.25×, both free.
 template <typename Change>
@@ -84,7 +76,7 @@ json workflow(const TwoBodyRecordSpec& spec, bool both) {
 }
 
 TEST(TwoBodyDriveStatus, item1_noise_clean_record_parameters_corrected) {
-  const TwoBodyRecordSpec spec = spec_of(2 * kDegree);
+  const TwoBodyRecordSpec spec = standard_record_spec(2 * kDegree);
   const json r = workflow(spec, true);
   ASSERT_TRUE(r.is_object());
   const json& n = r["two_body"]["noise"];
@@ -105,7 +97,7 @@ TEST(TwoBodyDriveStatus, item1_noise_clean_record_parameters_corrected) {
 }
 
 TEST(TwoBodyDriveStatus, item1_noise_missing_piece_partly_explained) {
-  const TwoBodyRecordSpec spec = spec_of(2 * kDegree);
+  const TwoBodyRecordSpec spec = standard_record_spec(2 * kDegree);
   const json r = workflow(spec, true, [](TwoBodyRecord& record) {
     for (std::size_t k = 0; k < record.drive.size(); ++k) record.drive[k] += 0.08 * std::sin(20 * record.state[k].theta_m);
   });
@@ -117,7 +109,7 @@ TEST(TwoBodyDriveStatus, item1_noise_missing_piece_partly_explained) {
 }
 
 TEST(TwoBodyDriveStatus, item2_motor_alone_sigma_covers_error) {
-  const TwoBodyRecordSpec spec = spec_of(5 * kDegree);
+  const TwoBodyRecordSpec spec = standard_record_spec(5 * kDegree);
   const json r = workflow(spec, false);
   ASSERT_TRUE(r.is_object());
   double b = NAN, sigma = NAN;

@@ -114,14 +114,6 @@ TEST(TwoBodyGenerator, HandSolvedCoulombStop) {
   EXPECT_NEAR(run.energy.work, run.energy.kinetic + run.energy.dissipated + run.energy.impact_losses, 1e-8 * run.energy.work);  // ∫CL·|ω| at odeint's tolerance
 }
 
-TwoBodyRecordSpec base_spec(double backlash) {
-  TwoBodyRecordSpec spec;
-  spec.plant.backlash = backlash;
-  spec.reference.amplitude = 0.8;
-  spec.current_noise = 0.002;
-  return spec;
-}
-
 // Every run: the motor's work = the kinetic and spring energy gained + the viscous, Coulomb
 // and mesh-damping losses + the impacts' + what a released overlapping mesh leaves behind.
 TEST(TwoBodyGenerator, EnergyBalances) {
@@ -133,7 +125,7 @@ TEST(TwoBodyGenerator, EnergyBalances) {
   for (const Case& c : {Case{"rigid teeth", kRigid, 0, 0, 0, false}, Case{"rigid, Coulomb both", kRigid, 0, 0.05, 0.08, false},
                         Case{"compliant mesh", 2000, 3, 0, 0, false}, Case{"compliant, Coulomb both", 2000, 3, 0.05, 0.08, false},
                         Case{"compliant, loop on the load", 5000, 2, 0.02, 0.03, true}}) {
-    TwoBodyRecordSpec spec = base_spec(3 * kDegree);
+    TwoBodyRecordSpec spec = standard_record_spec(3 * kDegree);
     spec.plant.stiffness = c.stiffness, spec.plant.damping = c.damping;
     spec.plant.coulomb_motor = c.coulomb_motor, spec.plant.coulomb_load = c.coulomb_load;
     spec.loop.on_load = c.on_load;
@@ -156,7 +148,7 @@ TEST(TwoBodyGenerator, EnergyBalances) {
 // The gap stays between its faces (rigid teeth), the bodies cross it at every reversal, the
 // encoders give whole counts, the record has its reversals, and it is the same every time.
 TEST(TwoBodyGenerator, GapLogAndReversals) {
-  TwoBodyRecordSpec spec = base_spec(5 * kDegree);
+  TwoBodyRecordSpec spec = standard_record_spec(5 * kDegree);
   spec.plant.coulomb_load = 0.05;
   const TwoBodyRecord a = generate_two_body_record(spec), b = generate_two_body_record(spec);
   EXPECT_EQ(a.drive, b.drive);
@@ -192,7 +184,7 @@ TEST(TwoBodyGenerator, GapLogAndReversals) {
 
 TEST(TwoBodyGenerator, RefusesWhatItCannotSimulate) {
   auto refused = [](auto change) {
-    TwoBodyRecordSpec spec = base_spec(kDegree);
+    TwoBodyRecordSpec spec = standard_record_spec(kDegree);
     change(spec);
     EXPECT_THROW(generate_two_body_record(spec), std::invalid_argument);
   };
@@ -292,7 +284,7 @@ std::string status(const json& result) { return result.is_object() ? result.valu
 // truth, free to be fitted; the loop on the motor or the load encoder.
 Drive drive(double backlash, bool both_encoders, bool on_load = false, std::uint64_t seed = 1) {
   Drive d;
-  d.spec = base_spec(backlash);
+  d.spec = standard_record_spec(backlash);
   d.spec.loop.on_load = on_load;
   d.spec.seed = seed;
   if (backlash > 0.2) d.spec.reference.amplitude = 1.2;  // the moves well beyond the gap

@@ -435,6 +435,14 @@ TwoBodyRun simulate_two_body(const TwoBodyPlant& plant, const std::vector<double
   return run;
 }
 
+TwoBodyRecordSpec standard_record_spec(double backlash) {
+  TwoBodyRecordSpec spec;
+  spec.plant.backlash = backlash;
+  spec.reference.amplitude = 0.8;
+  spec.current_noise = 0.002;
+  return spec;
+}
+
 TwoBodyRecord generate_two_body_record(const TwoBodyRecordSpec& spec) {
   check_plant(spec.plant);
   const TwoBodyLoop& loop = spec.loop;

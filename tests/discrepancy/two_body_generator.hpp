@@ -131,6 +131,10 @@ struct TwoBodyRecord {
   int reversals = 0;  ///< of the motor's true motion (sign changes of θ̇m beyond 30 % of V)
 };
 
+/// The workflow tests' standard record with backlash b [rad]: moves between ±0.8 rad and a
+/// logged drive with noise σ = 0.002; the rest as TwoBodyRecordSpec's defaults.
+TwoBodyRecordSpec standard_record_spec(double backlash);
+
 /// The closed-loop record, deterministic for a given spec.  std::invalid_argument for a spec
 /// it cannot simulate (J ≤ 0, F < 0, C < 0, b < 0, k ≤ 0, c < 0, T ≤ 0, A ≤ 0, V ≤ 0,
 /// ramp ≤ 0, moves < 1, gain = 0, a move too short for its ramps); std::runtime_error when the loop
