@@ -31,4 +31,13 @@ DriveBand drive_band(const std::vector<double>& q, const std::vector<double>& u,
 /// of its absolute sum), plus two for the difference stencils.
 std::size_t drive_filter_edge(const measurements::ButterworthLowPass& filter);
 
+/// The sums of squares of the impulse responses of the operators a torque residual applies to
+/// white noise: the held drive (the hold's weights at `delay_samples`, then the filter), the
+/// filter then the first and second differences (velocity, acceleration; `fs` the sampling
+/// rate), and the filter's complement δ − h (the band above the cut-off).
+struct NoiseGains {
+  double hold = 0, velocity = 0, acceleration = 0, high = 0;
+};
+NoiseGains noise_gains(const measurements::ButterworthLowPass& filter, double fs, double delay_samples);
+
 }  // namespace backlash::discrepancy::detail

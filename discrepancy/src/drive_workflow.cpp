@@ -683,21 +683,12 @@ std::vector<TorqueRegion> stretches_of(const Prepared& p, const std::vector<doub
 
 
 // The torque residual's noise level: the drive's and the position's noise propagated through
-// the filter and the differences (the sum of squares of each operator's impulse response).
+// the filter and the differences (the sum of squares of each operator's impulse response), the
+// drive's through the hold's weights at the model's delay.
 double noise_level(double fs, const Band& band, double drive_noise, double position_noise, const Theta& m) {
-  const std::size_t n = 4096, middle = n / 2;
-  std::vector<double> impulse(n, 0.0);
-  impulse[middle] = 1;
-  const std::vector<double> h = measurements::zero_phase_filter(impulse, band.filter);
-  const measurements::Derivatives d = measurements::derivatives(h, fs);
-  // The drive's noise through the hold's weights (at the model's delay) and the filter.
-  std::vector<double> held(n, 0.0);
-  const double mu = m[kTau] * fs;
-  for (std::size_t k = 0; k < n; ++k) held[k] = hold_weight(static_cast<double>(k) - mu - static_cast<double>(middle));
-  const std::vector<double> hu = measurements::zero_phase_filter(held, band.filter);
-  double hh = 0, vv = 0, aa = 0;
-  for (std::size_t i = 0; i < n; ++i) hh += hu[i] * hu[i], vv += d.velocity[i] * d.velocity[i], aa += d.acceleration[i] * d.acceleration[i];
-  return std::sqrt(drive_noise * drive_noise * hh + position_noise * position_noise * (m[kJ] * m[kJ] * aa + m[kF] * m[kF] * vv));
+  const detail::NoiseGains g = detail::noise_gains(band.filter, fs, m[kTau] * fs);
+  return std::sqrt(drive_noise * drive_noise * g.hold +
+                   position_noise * position_noise * (m[kJ] * m[kJ] * g.acceleration + m[kF] * m[kF] * g.velocity));
 }
 
 // The model and records a measured-drive workflow needs: a drive experiment, no backlash, the
@@ -1108,5 +1099,25 @@ DriveDiscrepancyResult find_drive_discrepancy(const model::CaseSpec& spec, const
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
+
+namespace detail {
+
+NoiseGains noise_gains(const measurements::ButterworthLowPass& filter, double fs, double delay_samples) {
+  const std::size_t n = 4096, middle = n / 2;
+  std::vector<double> impulse(n, 0.0), held(n, 0.0);
+  impulse[middle] = 1;
+  for (std::size_t k = 0; k < n; ++k) held[k] = hold_weight(static_cast<double>(k) - delay_samples - static_cast<double>(middle));
+  const std::vector<double> h = measurements::zero_phase_filter(impulse, filter);
+  const std::vector<double> hu = measurements::zero_phase_filter(held, filter);
+  const measurements::Derivatives d = measurements::derivatives(h, fs);
+  NoiseGains g;
+  for (std::size_t i = 0; i < n; ++i) {
+    g.hold += hu[i] * hu[i], g.velocity += d.velocity[i] * d.velocity[i], g.acceleration += d.acceleration[i] * d.acceleration[i];
+    g.high += (impulse[i] - h[i]) * (impulse[i] - h[i]);
+  }
+  return g;
+}
+
+}  // namespace detail
 
 }  // namespace backlash::discrepancy

@@ -3,6 +3,7 @@
 // propagated through the zero-phase filter, the differences and the summed equation.
 #include "two_body_signals.hpp"
 
+#include "drive_internal.hpp"
 #include "internal.hpp"
 
 #include <Eigen/Dense>
@@ -13,29 +14,6 @@
 namespace backlash::discrepancy::two_body {
 
 namespace {
-
-// The sums of squares of the impulse responses of the operators the residual applies: the
-// held drive's average and the filter (hold), the filter and the first and second differences
-// (velocity, acceleration), and the filter's complement δ − h (the band above the cut-off).
-struct Gains {
-  double hold = 0, velocity = 0, acceleration = 0, high = 0;
-};
-
-Gains gains_of(const measurements::ButterworthLowPass& filter, double fs) {
-  const std::size_t n = 4096, middle = n / 2;
-  std::vector<double> impulse(n, 0.0), held(n, 0.0);
-  impulse[middle] = 1;
-  held[middle] = held[middle + 1] = 0.5;  // the zero-order hold's average, 0.5·(u_k + u_{k−1})
-  const std::vector<double> h = measurements::zero_phase_filter(impulse, filter);
-  const std::vector<double> hu = measurements::zero_phase_filter(held, filter);
-  const measurements::Derivatives d = measurements::derivatives(h, fs);
-  Gains g;
-  for (std::size_t i = 0; i < n; ++i) {
-    g.hold += hu[i] * hu[i], g.velocity += d.velocity[i] * d.velocity[i], g.acceleration += d.acceleration[i] * d.acceleration[i];
-    g.high += (impulse[i] - h[i]) * (impulse[i] - h[i]);
-  }
-  return g;
-}
 
 // σ of an encoder's error: its step/√12 when the record is whole counts of a step
 // (detail::quantum_of), else the Δ⁴ estimate of the position as the rigid workflow's.
@@ -52,7 +30,7 @@ double encoder_sigma(const std::vector<double>& q, double& step) {
 // differences, a short filter); σ is the robust scale (1.4826·median |e|) of what remains, over
 // the white noise's share of that band (Σ(δ − h)²).  A controller acting on more than the
 // encoders' last four counts leaves part of its reaction in: an upper bound then.
-double drive_sigma(const Signals& s, const Gains& g) {
+double drive_sigma(const Signals& s, const detail::NoiseGains& g) {
   constexpr std::size_t lags = 4;
   auto high = [&](const std::vector<double>& x) {
     std::vector<double> out = measurements::zero_phase_filter(x, s.filter);
@@ -84,7 +62,8 @@ double drive_sigma(const Signals& s, const Gains& g) {
 }  // namespace
 
 TwoBodyNoise noise_level(const Signals& s, const Theta& m) {
-  const Gains g = gains_of(s.filter, s.fs);
+  // No delay on a drive with a gap: the hold's weights ½, ½ on the sample and the one before.
+  const detail::NoiseGains g = detail::noise_gains(s.filter, s.fs, 0);
   TwoBodyNoise n;
   n.sigma_motor = encoder_sigma(s.qm, n.step_motor);
   n.sigma_drive = drive_sigma(s, g);
