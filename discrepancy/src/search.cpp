@@ -374,6 +374,9 @@ void add_reverse_starts(Search& s, std::vector<std::vector<const Screened*>>& ch
     if (std::isfinite(reversed[i].sse)) chosen[which[i]].push_back(&reversed[i]);
 }
 
+// A pair's name, the same from either single: "a + b" in name order.
+std::string pair_key(const std::string& a, const std::string& b) { return std::min(a, b) + " + " + std::max(a, b); }
+
 // "The best single plus one": each of the round's best kSingles singles S (fitted, by BIC) with
 // every other candidate screened at S's fit (a scan of the partner alone); the kPartners best partners
 // of each S fitted together with it (from S's fit and the partner's best scan point; a quarter
@@ -415,16 +418,13 @@ std::optional<Trial> best_pair(Search& s, const std::vector<Trial>& singles, dou
     std::sort(mine.begin(), mine.end(), [](const Screened* a, const Screened* b) { return a->sse < b->sse; });
     for (std::size_t k = 0; k < std::min<std::size_t>(kPartners, mine.size()); ++k) {
       const std::string a = mine[k]->single->result.effect, b = mine[k]->partner->result.effect;
-      const auto [at, added] = seen.emplace(std::min(a, b) + " + " + std::max(a, b), chosen.size());
+      const auto [at, added] = seen.emplace(pair_key(a, b), chosen.size());
       if (added) chosen.push_back({mine[k]});
       else chosen[at->second].push_back(mine[k]);
     }
   }
   for (const Screened& x : screened)  // refused combinations, by name
-    if (!x.problem.empty() && seen.emplace(std::min(x.single->result.effect, x.partner->result.effect) + " + " +
-                                               std::max(x.single->result.effect, x.partner->result.effect),
-                                           chosen.size())
-                                  .second) {
+    if (!x.problem.empty() && seen.emplace(pair_key(x.single->result.effect, x.partner->result.effect), chosen.size()).second) {
       Candidate refused;
       refused.effect = x.single->result.effect + " + " + x.partner->result.effect;
       refused.failure = x.problem;
@@ -536,6 +536,9 @@ void name_pair(Search& s, const Trial& pair, const std::vector<Trial>& singles) 
   }
   s.current = pair.point;
 }
+
+// The current model's residual still above the noise level (its Huber RMS: docs/discrepancy.md).
+bool above_noise(const Search& s) { return s.scores.robust_rms() > at_noise_level(s.o, s.options.noise_level); }
 
 // The model of everything named but the i-th, at the named values (not refitted), and the
 // directions in which those others move the residual (directions()).
@@ -666,7 +669,7 @@ void run_search(Search& s, std::vector<std::string> remaining) {
   auto erase = [&](const std::string& name) { remaining.erase(std::remove(remaining.begin(), remaining.end(), name), remaining.end()); };
   for (const Named& n : s.named) erase(n.result.effect);
   auto go_on = [&](int round) {
-    return round < s.options.max_effects + 2 && s.scores.robust_rms() > at_noise_level(s.o, s.options.noise_level) &&
+    return round < s.options.max_effects + 2 && above_noise(s) &&
            static_cast<int>(s.named.size()) < s.options.max_effects && !remaining.empty() && !s.simulator.budget_reached();
   };
   for (int rounds = 0; go_on(rounds); ++rounds) {
@@ -696,7 +699,7 @@ void run_search(Search& s, std::vector<std::string> remaining) {
       if (const auto point = joint_refit(s, s.named)) s.current = *point;
     if (!s.rescore()) break;
     replace_needless(s);  // a dropped candidate is not tried again
-    if (s.scores.robust_rms() > at_noise_level(s.o, s.options.noise_level)) erase(swap_correction(s, remaining));
+    if (above_noise(s)) erase(swap_correction(s, remaining));
     // The noise re-read from what the model now leaves: a large gap hides the noise's colour.
     if (const auto traces = s.simulator.traces(s.current, s.o.size())) {
       reestimate_noise(s.o, *traces);
