@@ -118,8 +118,8 @@ bool spurious_separation(const Parameters& p, const ModeFlow& flow, double tau) 
 }  // namespace
 
 // Only c, eᵀc, eᵀA c and eᵀA² c depend on the forcing c (which moves with the start: the drive
-// folded in); they are formed as WitnessMode's constructor forms them, the others (eᵀA^k, the
-// balancing, μ∞, the norms) come from A and e alone.  Exact comparison of A and e.  Building the
+// folded in): WitnessMode::set_forcing; the others (eᵀA^k, the balancing, μ∞, the norms) come
+// from A and e alone.  Exact comparison of A and e.  Building the
 // constants per search was a third of a closed-form segment's cost (issue 19).
 WitnessMode detail::witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e) {
   thread_local std::vector<WitnessMode> cache;
@@ -128,10 +128,7 @@ WitnessMode detail::witness_mode(const SmallMatrix& A, const SmallVector& c, con
   for (const WitnessMode& m : cache) {
     if (!same(m.A, A) || !same(m.e, e)) continue;
     WitnessMode hit = m;
-    hit.c = c;
-    hit.ec = e.dot(c);
-    hit.eAc = hit.eA.dot(c);
-    hit.eA2c = hit.eA2.dot(c);
+    hit.set_forcing(c);
     return hit;
   }
   constexpr std::size_t capacity = 32;

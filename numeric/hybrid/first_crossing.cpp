@@ -344,13 +344,11 @@ WitnessSample sample_of(const LinearWitness& witness, double t) {
 }  // namespace
 
 WitnessMode::WitnessMode(const SmallMatrix& A_, const SmallVector& c_, const SmallRow& e_, double time_unit_)
-    : A(A_), c(c_), e(e_), time_unit(time_unit_) {
+    : A(A_), e(e_), time_unit(time_unit_) {
   eA = e * A;
   eA2 = eA * A;
   eA3 = eA2 * A;
-  ec = e.dot(c);
-  eAc = eA.dot(c);
-  eA2c = eA2.dot(c);
+  set_forcing(c_);
   mu_A = log_norm(A);
   first_window = window_of(A);
   scale = SmallVector::Ones(A.rows());
@@ -370,6 +368,13 @@ WitnessMode::WitnessMode(const SmallMatrix& A_, const SmallVector& c_, const Sma
   norm_eA = eA.cwiseAbs().sum();
   norm_A = (scale.asDiagonal() * A).cwiseAbs().rowwise().sum().maxCoeff();
   inverse_scale = scale.cwiseInverse().maxCoeff();
+}
+
+void WitnessMode::set_forcing(const SmallVector& forcing) {
+  c = forcing;
+  ec = e.dot(c);
+  eAc = eA.dot(c);
+  eA2c = eA2.dot(c);
 }
 
 std::optional<double> certified_departure(const WitnessMode& W, const SmallVector& x0, double noise) {

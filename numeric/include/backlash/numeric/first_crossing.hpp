@@ -106,6 +106,9 @@ struct WitnessSample {
 /// set, not per search.
 struct WitnessMode {
   WitnessMode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e, double time_unit = 1);
+  /// The forcing c and the constants that depend on it (eᵀc, eᵀA c, eᵀA² c); the rest come
+  /// from A and e alone, so a mode kept for its (A, e) serves another forcing.
+  void set_forcing(const SmallVector& forcing);
   SmallMatrix A;
   SmallVector c;
   SmallRow e, eA, eA2, eA3;
