@@ -115,15 +115,21 @@ void drive_limit_witnesses(const Parameters& p, const Effects& e, const Mode& m,
 
 }  // namespace
 
-std::vector<Witness> mode_witnesses(const Parameters& p, const Effects& e, const Mode& m, const ModeFunctionals& f,
-                                    bool with_drive_limits) {
-  std::vector<Witness> out;
+void mode_witnesses(const Parameters& p, const Effects& e, const Mode& m, const ModeFunctionals& f, bool with_drive_limits,
+                    std::vector<Witness>& out) {
+  out.clear();
   switch (m.kind) {
     case ModeKind::Contact: contact_witnesses(p, e, m, f, out); break;
     case ModeKind::Free: free_witnesses(p, e, m, f, out); break;
     case ModeKind::Mesh: mesh_witnesses(p, e, m, f, out); break;
   }
   if (with_drive_limits) drive_limit_witnesses(p, e, m, f, out);
+}
+
+std::vector<Witness> mode_witnesses(const Parameters& p, const Effects& e, const Mode& m, const ModeFunctionals& f,
+                                    bool with_drive_limits) {
+  std::vector<Witness> out;
+  mode_witnesses(p, e, m, f, with_drive_limits, out);
   return out;
 }
 

@@ -86,6 +86,9 @@ struct ModeFunctionals {
 };
 std::vector<Witness> mode_witnesses(const Parameters& p, const Effects& e, const Mode& m, const ModeFunctionals& f,
                                     bool with_drive_limits);
+/// The same into `out` (cleared first; its storage kept: no allocation per segment once it has grown).
+void mode_witnesses(const Parameters& p, const Effects& e, const Mode& m, const ModeFunctionals& f, bool with_drive_limits,
+                    std::vector<Witness>& out);
 
 /// The motion in one mode from the engine's current state.
 class Segment {
@@ -162,6 +165,9 @@ class Engine {
 /// thread for the last few (A, e) (effects_simulation.cpp): only the forcing's terms are formed
 /// again when a mode is entered with the same matrix and guard.
 WitnessMode witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e);
+/// The same without the copy: the kept entry itself, its forcing set to c — valid until the next
+/// call on this thread (copy it to keep it).
+const WitnessMode& kept_witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e);
 
 /// The closed-form segment of mode `m` from `start` (effects_simulation.cpp) with `extra` guards
 /// besides the mode's own (Handover guards: their exit ends the segment without an exit);

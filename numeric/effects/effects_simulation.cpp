@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -51,7 +53,17 @@ double departure_time(const LinearWitness& lw, const SmallVector& zdot0, const s
   const double norm_A = lw.A.cwiseAbs().rowwise().sum().maxCoeff(), norm_z = zdot0.cwiseAbs().maxCoeff();
   const double norm_eAK = eAK.cwiseAbs().sum();
   double tau = horizon;
-  for (int i = 0; i < 400 && tau > 0; ++i, tau *= 0.5) {
+  int i = 0;
+  // The remainder's term alone (e^{‖A‖τ} ≥ 1) is at least twice the leading one, so the bound is
+  // negative, while τ > 4(K+1)·w_K/(‖e A^K‖₁‖ż(0)‖∞) (twice that far, for the rounding): those τ are
+  // passed over without evaluating it (the departure is found on the mode's own time scale, not
+  // by halving down from the horizon; the same τ as halving, which is exact).
+  const double remainder_rate = norm_eAK * norm_z;
+  if (remainder_rate > 0 && std::isfinite(remainder_rate)) {
+    const double beyond = 4 * (K + 1) * w[K] / remainder_rate;
+    for (; i < 400 && tau > 0 && tau > beyond; ++i) tau *= 0.5;
+  }
+  for (; i < 400 && tau > 0; ++i, tau *= 0.5) {
     std::array<double, 5> power{1, tau, tau * tau, tau * tau * tau, tau * tau * tau * tau};
     double lower = w[K] * power[K] / factorial(K) -
                    norm_eAK * std::exp(norm_A * tau) * norm_z * power[K + 1] / factorial(K + 1);
@@ -120,18 +132,22 @@ bool spurious_separation(const Parameters& p, const ModeFlow& flow, double tau) 
 // Only c, eᵀc, eᵀA c and eᵀA² c depend on the forcing c (which moves with the start: the drive
 // folded in): WitnessMode::set_forcing; the others (eᵀA^k, the balancing, μ∞, the norms) come
 // from A and e alone.  Exact comparison of A and e.  Building the
-// constants per search was a third of a closed-form segment's cost (issue 19).
-WitnessMode detail::witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e) {
-  thread_local std::vector<WitnessMode> cache;
+// constants per search was a third of a closed-form segment's cost (issue 19).  The entry kept
+// for (A, e) is given the forcing c and returned as it is (the caller copies it before the next call).
+const WitnessMode& detail::kept_witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e) {
+  constexpr std::size_t capacity = 32;
+  thread_local std::vector<WitnessMode> cache = [] {
+    std::vector<WitnessMode> v;
+    v.reserve(capacity);
+    return v;
+  }();
   thread_local std::size_t next = 0;
   const auto same = [](const auto& x, const auto& y) { return x.rows() == y.rows() && x.cols() == y.cols() && x == y; };
-  for (const WitnessMode& m : cache) {
-    if (!same(m.A, A) || !same(m.e, e)) continue;
-    WitnessMode hit = m;
-    hit.set_forcing(c);
-    return hit;
+  for (WitnessMode& m : cache) {
+    if (!same(m.e, e) || !same(m.A, A)) continue;
+    m.set_forcing(c);
+    return m;
   }
-  constexpr std::size_t capacity = 32;
   if (cache.size() < capacity) return cache.emplace_back(A, c, e);
   cache[next] = WitnessMode(A, c, e);
   const std::size_t at = next;
@@ -139,21 +155,55 @@ WitnessMode detail::witness_mode(const SmallMatrix& A, const SmallVector& c, con
   return cache[at];
 }
 
+WitnessMode detail::witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e) {
+  return kept_witness_mode(A, c, e);
+}
+
 namespace {
+
+// The closed-form samples of one segment, shared by its witnesses' searches: every witness is
+// searched over the same windows, each search's windows start where its last one ended, and the
+// first window is the mode's own (WitnessMode::first_window: A alone), so the same τ is asked for
+// again and again.  The last few evaluations are kept and given again (an exact match of τ's bits:
+// the same τ gives the same bits).
+class SampleMemo {
+ public:
+  explicit SampleMemo(const ModeFlow& flow) : flow_(flow) {}
+  SmallVector local(double tau) const {
+    std::uint64_t key;
+    std::memcpy(&key, &tau, sizeof key);
+    for (int i = 0; i < size_; ++i)
+      if (keys_[i] == key) return z_[i];
+    const int at = next_;
+    next_ = (next_ + 1) % capacity;
+    size_ = std::max(size_, next_ == 0 ? capacity : next_);
+    keys_[at] = key;
+    z_[at] = flow_.local(tau);
+    return z_[at];
+  }
+
+ private:
+  static constexpr int capacity = 16;
+  const ModeFlow& flow_;
+  mutable std::array<std::uint64_t, capacity> keys_{};
+  mutable std::array<SmallVector, capacity> z_;
+  mutable int size_ = 0, next_ = 0;
+};
 
 // The certified search for one witness's first exit, advanced window by window.
 class ExitSearch {
  public:
-  ExitSearch(const Parameters& p, const ModeFlow& flow, const Witness& witness, double horizon, double t_global)
-      : p_(p), flow_(flow), witness_(witness) {
+  ExitSearch(const Parameters& p, const ModeFlow& flow, const SampleMemo& memo, const Witness& witness, double horizon,
+             double t_global)
+      : p_(p), flow_(flow), memo_(memo), witness_(witness) {
     lw_.A = flow.segment().A;
     lw_.c = flow.segment().c;
     lw_.e = witness.f.row;
     lw_.level = -witness.f.constant;
-    lw_.state = [&flow](double tau) { return flow.local(tau); };
     lw_.third_derivative_bound = flow.derivative_bound(lw_.e, 3);
     // Without a stiff bound the search on a mode built once is the LinearWitness search, bit for bit.
-    if (!lw_.third_derivative_bound) mode_.emplace(detail::witness_mode(lw_.A, lw_.c, lw_.e));
+    if (!lw_.third_derivative_bound) mode_.emplace(detail::kept_witness_mode(lw_.A, lw_.c, lw_.e));
+    else lw_.state = [&memo](double tau) { return memo.local(tau); };
     const Start start = classify_start(flow, lw_, witness.f.magnitude, horizon, t_global);
     if (start.kind == StartKind::Never) finished_ = true;
     if (start.kind == StartKind::ExitNow) immediate_ = true;
@@ -186,7 +236,7 @@ class ExitSearch {
   std::optional<Crossing> search(double until) const {
     if (!mode_) return first_crossing(lw_, from_, until);
     const auto sample = [this](double tau) {
-      WitnessSample s{flow_.local(tau), 0};
+      WitnessSample s{memo_.local(tau), 0};
       s.value = lw_.e.dot(s.x);
       return s;
     };
@@ -194,6 +244,7 @@ class ExitSearch {
   }
   const Parameters& p_;
   const ModeFlow& flow_;
+  const SampleMemo& memo_;
   Witness witness_;
   LinearWitness lw_;
   std::optional<WitnessMode> mode_;  // the witness's constants, when the search needs no stiff bound
@@ -213,11 +264,17 @@ class ClosedFormSegment final : public detail::Segment {
     }
     // Every witness searched window by window, the windows doubling from an eighth of the servo
     // period: the search stops at the first window that holds an exit, never far beyond it.
-    std::vector<ExitSearch> searches;
-    std::vector<Witness> witnesses = detail::mode_witnesses(p, e, m, functionals_of(p, e, flow_, left_zone), true);
+    // The witnesses and their searches in storage kept per thread (no allocation per segment); a
+    // segment's searches are all done here, before the next segment is built.
+    thread_local std::vector<Witness> witnesses;
+    thread_local std::vector<ExitSearch> searches;
+    searches.clear();
+    detail::mode_witnesses(p, e, m, functionals_of(p, e, flow_, left_zone), true, witnesses);
     witnesses.insert(witnesses.end(), extra.begin(), extra.end());
+    const SampleMemo memo(flow_);
+    searches.reserve(witnesses.size());
     for (const Witness& w : witnesses) {
-      searches.emplace_back(p, flow_, w, horizon, t_global);
+      searches.emplace_back(p, flow_, memo, w, horizon, t_global);
       if (searches.back().immediate()) {
         duration = 0;
         if (w.guard != Guard::Handover) exit = Exit{0, w, false};  // a handover at once: an empty segment
