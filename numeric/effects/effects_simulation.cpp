@@ -86,26 +86,31 @@ struct Start {
 // (A looser on-boundary rule — 1e-11 of the terms — took a real 1e-11 gap for a contact.)
 // On the boundary, the first derivative that is not noise decides: leaving the valid side is
 // an exit at once, entering it starts the search after a certified departure time.
-Start classify_start(const ModeFlow& flow, const LinearWitness& lw, double magnitude, double horizon, double t_global) {
+// With the witness's mode (`mode`: its eᵀA, eᵀA² are the products formed here, the same bits) they
+// are not formed again; the higher derivatives and their rounding scales only on the boundary.
+Start classify_start(const ModeFlow& flow, const LinearWitness& lw, const WitnessMode* mode, double magnitude,
+                     double horizon, double t_global) {
   const SmallVector& z0 = flow.local_start();
   const SmallVector& z0_noise = flow.local_start_noise();
   const SmallVector zdot = lw.A * z0 + lw.c;
-  const SmallVector zdot_scale = lw.A.cwiseAbs() * (z0.cwiseAbs() + z0_noise) + flow.forcing_magnitude();
   std::array<double, 4> w{};
-  std::array<double, 4> scale{};
   w[0] = lw.e.dot(z0) - lw.level;
-  SmallRow e = lw.e;
-  for (int k = 1; k <= 3; ++k) {
-    w[k] = e.dot(zdot);
-    scale[k] = e.cwiseAbs().dot(zdot_scale.transpose());
-    e = e * lw.A;
-  }
+  w[1] = lw.e.dot(zdot);
   constexpr double eps = std::numeric_limits<double>::epsilon();
   const double tolerance = 64 * eps * (lw.e.cwiseAbs().dot(z0.cwiseAbs().transpose()) + magnitude) +
                            32 * lw.e.cwiseAbs().dot(z0_noise.transpose()) +
                            std::fabs(w[1]) * 4e-14 * std::max(1.0, std::fabs(t_global));
   if (w[0] > tolerance) return {StartKind::Inside, 0};
   if (w[0] < -tolerance) return {StartKind::ExitNow, 0};
+  const SmallVector zdot_scale = lw.A.cwiseAbs() * (z0.cwiseAbs() + z0_noise) + flow.forcing_magnitude();
+  const SmallRow eA = mode ? mode->eA : SmallRow(lw.e * lw.A);
+  const SmallRow eA2 = mode ? mode->eA2 : SmallRow(eA * lw.A);
+  const std::array<const SmallRow*, 4> rows{nullptr, &lw.e, &eA, &eA2};  // e A^{k−1} for w^{(k)}
+  std::array<double, 4> scale{};
+  for (int k = 1; k <= 3; ++k) {
+    if (k > 1) w[k] = rows[k]->dot(zdot);
+    scale[k] = rows[k]->cwiseAbs().dot(zdot_scale.transpose());
+  }
   for (int K = 1; K <= 3; ++K) {
     if (std::fabs(w[K]) <= 1e-9 * scale[K]) continue;
     if (w[K] < 0) return {StartKind::ExitNow, 0};
@@ -204,7 +209,7 @@ class ExitSearch {
     // Without a stiff bound the search on a mode built once is the LinearWitness search, bit for bit.
     if (!lw_.third_derivative_bound) mode_.emplace(detail::kept_witness_mode(lw_.A, lw_.c, lw_.e));
     else lw_.state = [&memo](double tau) { return memo.local(tau); };
-    const Start start = classify_start(flow, lw_, witness.f.magnitude, horizon, t_global);
+    const Start start = classify_start(flow, lw_, mode_ ? &*mode_ : nullptr, witness.f.magnitude, horizon, t_global);
     if (start.kind == StartKind::Never) finished_ = true;
     if (start.kind == StartKind::ExitNow) immediate_ = true;
     from_ = start.from;
