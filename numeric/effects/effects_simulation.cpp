@@ -88,11 +88,11 @@ struct Start {
 // an exit at once, entering it starts the search after a certified departure time.
 // With the witness's mode (`mode`: its eᵀA, eᵀA² are the products formed here, the same bits) they
 // are not formed again; the higher derivatives and their rounding scales only on the boundary.
-Start classify_start(const ModeFlow& flow, const LinearWitness& lw, const WitnessMode* mode, double magnitude,
-                     double horizon, double t_global) {
+// `zdot` = A z0 + c, the start's rate, the same for every witness of the segment.
+Start classify_start(const ModeFlow& flow, const LinearWitness& lw, const WitnessMode* mode, const SmallVector& zdot,
+                     double magnitude, double horizon, double t_global) {
   const SmallVector& z0 = flow.local_start();
   const SmallVector& z0_noise = flow.local_start_noise();
-  const SmallVector zdot = lw.A * z0 + lw.c;
   std::array<double, 4> w{};
   w[0] = lw.e.dot(z0) - lw.level;
   w[1] = lw.e.dot(zdot);
@@ -198,8 +198,8 @@ class SampleMemo {
 // The certified search for one witness's first exit, advanced window by window.
 class ExitSearch {
  public:
-  ExitSearch(const Parameters& p, const ModeFlow& flow, const SampleMemo& memo, const Witness& witness, double horizon,
-             double t_global)
+  ExitSearch(const Parameters& p, const ModeFlow& flow, const SampleMemo& memo, const SmallVector& zdot,
+             const Witness& witness, double horizon, double t_global)
       : p_(p), flow_(flow), memo_(memo), witness_(witness) {
     lw_.A = flow.segment().A;
     lw_.c = flow.segment().c;
@@ -209,7 +209,7 @@ class ExitSearch {
     // Without a stiff bound the search on a mode built once is the LinearWitness search, bit for bit.
     if (!lw_.third_derivative_bound) mode_.emplace(detail::kept_witness_mode(lw_.A, lw_.c, lw_.e));
     else lw_.state = [&memo](double tau) { return memo.local(tau); };
-    const Start start = classify_start(flow, lw_, mode_ ? &*mode_ : nullptr, witness.f.magnitude, horizon, t_global);
+    const Start start = classify_start(flow, lw_, mode_ ? &*mode_ : nullptr, zdot, witness.f.magnitude, horizon, t_global);
     if (start.kind == StartKind::Never) finished_ = true;
     if (start.kind == StartKind::ExitNow) immediate_ = true;
     from_ = start.from;
@@ -277,9 +277,10 @@ class ClosedFormSegment final : public detail::Segment {
     detail::mode_witnesses(p, e, m, functionals_of(p, e, flow_, left_zone), true, witnesses);
     witnesses.insert(witnesses.end(), extra.begin(), extra.end());
     const SampleMemo memo(flow_);
+    const SmallVector zdot = flow_.segment().A * flow_.local_start() + flow_.segment().c;  // ż(0)
     searches.reserve(witnesses.size());
     for (const Witness& w : witnesses) {
-      searches.emplace_back(p, flow_, memo, w, horizon, t_global);
+      searches.emplace_back(p, flow_, memo, zdot, w, horizon, t_global);
       if (searches.back().immediate()) {
         duration = 0;
         if (w.guard != Guard::Handover) exit = Exit{0, w, false};  // a handover at once: an empty segment
