@@ -56,69 +56,117 @@ struct LevelEvent {
   Crossing crossing;
 };
 
-std::optional<LevelEvent> sequential_search(const Level& first, const Level& second, double horizon) {
-  const std::optional<Crossing> a = first.search(first.start, horizon);
+// The reference's answer from the first level's whole search: the second searched up to its crossing.
+std::optional<LevelEvent> with_second(const std::optional<Crossing>& a, const Level& second, double horizon) {
   const std::optional<Crossing> b = second.search(second.start, a ? a->t : horizon);
   if (b && (!a || b->t < a->t)) return LevelEvent{true, *b};
   if (a) return LevelEvent{false, *a};
   return std::nullopt;
 }
 
-// One level advanced over its whole search's windows: none crosses on (start, end] unless found.
+std::optional<LevelEvent> sequential_search(const Level& first, const Level& second, double horizon) {
+  return with_second(first.search(first.start, horizon), second, horizon);
+}
+
+// The first stretch of each level, searched as its whole search searches it (windows 0, 1, 2 of
+// first_crossing's search: 7 of the mode's time scales): a crossing there is the reference's at
+// once, and most flights end there.
+constexpr int kFirstStretchWindows = 3;
+
+// One level advanced over its whole search's windows: none crosses on (start, end] unless found;
+// (begin, end] is the window searched last, or the one holding the crossing found.
 struct Track {
   const Level& level;
-  double horizon, window, begin, end;
-  int windows = 0;
+  double horizon, first_window, window, begin, end;
+  bool started = false, exact = false;  ///< exact: found by the level's whole search (its reference time)
   std::optional<Crossing> found;
 
-  Track(const Level& l, double horizon_, double first_window)
-      : level(l), horizon(horizon_), window(first_window), begin(l.start), end(l.start) {}
+  Track(const Level& l, double horizon_, double first_window_)
+      : level(l), horizon(horizon_), first_window(first_window_), window(first_window_), begin(l.start), end(l.start) {}
   bool exhausted() const { return found || end >= horizon; }
   // No crossing of this level on (start, x] (x ≤ horizon, or the horizon reached).
   bool clear_beyond(double x) const { return found ? found->t > x : (end >= x || end >= horizon); }
-  void advance() {  // the next window, its end as first_crossing's search computes it
+  // The whole search's windows from the start, its ends computed as first_crossing's search does,
+  // up to the first one that ends at or after `t`, `count` of them at least: (begin, end].
+  void windows_to(double t, int count) {
+    begin = end = level.start;
+    window = first_window;
+    for (int i = 0; end < horizon && (i < count || end < t); ++i) {
+      begin = end;
+      end = horizon - begin <= window ? horizon : begin + window;
+      window *= 2;
+    }
+  }
+  // The first call: the level's whole search over its first windows, to `reach` at least (its
+  // crossing there is the reference's).  Later calls: the next window, a certified search of its own.
+  void advance(double reach, int windows = 1) {
+    if (!started) {
+      started = exact = true;
+      windows_to(reach, windows);
+      found = level.search(level.start, end);
+      if (found) windows_to(found->t, 1);  // the window that holds it
+      return;
+    }
+    exact = false;
     begin = end;
     end = horizon - begin <= window ? horizon : begin + window;
     window *= 2;
-    ++windows;
     found = level.search(begin, end);
   }
-  // The crossing as the level's whole search finds it: the first window's search is that search's
-  // own first window; a later window's crossing is found again by the whole search (which stops
-  // there), and must be the same crossing in the same window.
+  // The crossing as the level's whole search finds it: found again by that search (which stops
+  // there) when a window of its own found it; it must be the same crossing in the same window.
   std::optional<Crossing> whole() const {
-    if (windows == 1) return found;
+    if (exact) return found;
     const std::optional<Crossing> w = level.search(level.start, horizon);
     if (!w || w->grazing || w->t > end || !(std::fabs(w->t - found->t) <= 1e-9 * found->t)) return std::nullopt;
     return w;
   }
 };
 
-std::optional<LevelEvent> windowed_search(const Level& first, const Level& second, double horizon, double first_window,
-                                          const long& samples) {
+// What the windows settle (`settled`: the event, or none on the whole horizon); the rest goes to
+// the sequential searches.
+struct Windowed {
+  bool settled = false;
+  std::optional<LevelEvent> event;
+};
+
+// After the first level's first stretch found nothing: both levels window by window.
+Windowed windowed_search(Track& a, Track& b, const long& samples) {
   const long budget = CrossingOptions{}.max_intervals;
-  Track a(first, horizon, first_window), b(second, horizon, first_window);
   try {
     for (;;) {
       if ((a.found && a.found->grazing) || (b.found && b.found->grazing) || samples > budget) break;
       // The second level's crossing stands when the first is clear past its window (the reference
       // searches the second level up to the first's crossing: its windows up to that one the same).
       if (b.found && a.clear_beyond(b.end + (b.end - b.begin) * 0x1p-20)) {
-        if (const auto w = b.whole()) return LevelEvent{true, *w};
+        if (const auto w = b.whole()) return {true, LevelEvent{true, *w}};
         break;
       }
       if (a.found && b.clear_beyond(a.found->t * (1 + 1e-9))) {
-        if (const auto w = a.whole()) return LevelEvent{false, *w};
+        if (const auto w = a.whole()) return {true, LevelEvent{false, *w}};
         break;
       }
       if (a.found && b.found) break;  // both within one window of each other: the reference decides
-      if (a.exhausted() && b.exhausted()) return std::nullopt;
-      Track& next = a.found ? b : b.found ? a : b.exhausted() || (!a.exhausted() && a.end <= b.end) ? a : b;
-      next.advance();
+      if (a.exhausted() && b.exhausted()) return {true, std::nullopt};
+      const bool first_next = !a.found && (b.found || b.exhausted() || (!a.exhausted() && a.end <= b.end));
+      (first_next ? a : b).advance((first_next ? b : a).end);
     }
   } catch (const SearchBudgetExhausted&) {
-    // the sequential searches below give the reference's answer or its own exhausted budget
+    // the sequential searches give the reference's answer or its own exhausted budget
   }
+  return {};
+}
+
+// The first level's first stretch as the reference searches it — a crossing there (or none on the
+// whole horizon) is the reference's, and the second level is then searched as the reference does
+// —, else both levels window by window, and the sequential searches where they cannot settle.
+std::optional<LevelEvent> windowed_levels(const Level& first, const Level& second, double horizon, double first_window,
+                                          const long& samples) {
+  Track a(first, horizon, first_window), b(second, horizon, first_window);
+  a.advance(-INFINITY, kFirstStretchWindows);
+  if (a.exhausted()) return with_second(a.found, second, horizon);
+  const Windowed windowed = windowed_search(a, b, samples);
+  if (windowed.settled) return windowed.event;
   return sequential_search(first, second, horizon);
 }
 
@@ -126,7 +174,7 @@ std::optional<LevelEvent> windowed_search(const Level& first, const Level& secon
 std::optional<LevelEvent> first_of_two_levels(const Level& first, const Level& second, double horizon,
                                               double first_window, const long& samples) {
   if (!(first_window > 0) || !std::isfinite(first_window)) return sequential_search(first, second, horizon);
-  return windowed_search(first, second, horizon, first_window, samples);
+  return windowed_levels(first, second, horizon, first_window, samples);
 }
 
 }  // namespace
