@@ -1,6 +1,7 @@
 #include "hybrid/gap_events.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace backlash::numeric::detail {
 
@@ -26,30 +27,202 @@ WitnessMode gap_witness_mode(const LinearSegment& free_segment, double time_unit
   return WitnessMode(free_segment.A, free_segment.c, e, time_unit);
 }
 
+namespace {
+
+// A flight's two gap levels, searched window by window together (docs/design.md, "The event loop").
+// The reference is the two searches one after the other: the `first` level over (start, horizon],
+// then the `second` up to the first's crossing, the earlier kept.  When the first level's crossing
+// is far off or absent (a nearly frictionless load: horizons of 60·JL/FL) that certifies the whole
+// horizon before the second level, which crosses in its first seconds, is even looked at.  Here
+// each level is advanced over its own search's windows (WitnessMode::first_window from its start,
+// each twice the one before: the windows first_crossing's whole search would use), the one behind
+// first, each window a certified first_crossing of its own on that span; the searches stop at the
+// first window in which a level crosses once the other is certified clear beyond it.  The crossing
+// kept is then the one the level's whole search from its start finds (the same crossing; its time
+// bit for bit the reference's, the windows of that search being the reference's up to it), so
+// event times are those of the sequential searches.  Whatever the windows cannot settle — a
+// grazing, two crossings closer than 1e-9 of their time, an exhausted budget — goes to the
+// sequential searches themselves.
+
+using SpanSearch = FunctionRef<std::optional<Crossing>(double, double)>;
+
+struct Level {
+  SpanSearch search;  ///< the certified first crossing in (lo, hi]; search(start, T) is the level's whole search
+  double start;       ///< no crossing on (0, start] (a departure certified clear up to there)
+};
+
+struct LevelEvent {
+  bool second;  ///< the second level crossed first
+  Crossing crossing;
+};
+
+// The reference's answer from the first level's whole search: the second searched up to its crossing.
+std::optional<LevelEvent> with_second(const std::optional<Crossing>& a, const Level& second, double horizon) {
+  const std::optional<Crossing> b = second.search(second.start, a ? a->t : horizon);
+  if (b && (!a || b->t < a->t)) return LevelEvent{true, *b};
+  if (a) return LevelEvent{false, *a};
+  return std::nullopt;
+}
+
+std::optional<LevelEvent> sequential_search(const Level& first, const Level& second, double horizon) {
+  return with_second(first.search(first.start, horizon), second, horizon);
+}
+
+// The first stretch of each level, searched as its whole search searches it (windows 0, 1, 2 of
+// first_crossing's search: 7 of the mode's time scales): a crossing there is the reference's at
+// once, and most flights end there.
+constexpr int kFirstStretchWindows = 3;
+
+// One level advanced over its whole search's windows: none crosses on (start, end] unless found;
+// (begin, end] is the window searched last, or the one holding the crossing found.
+struct Track {
+  const Level& level;
+  double horizon, first_window, window, begin, end;
+  bool started = false, exact = false;  ///< exact: found by the level's whole search (its reference time)
+  std::optional<Crossing> found;
+
+  Track(const Level& l, double horizon_, double first_window_)
+      : level(l), horizon(horizon_), first_window(first_window_), window(first_window_), begin(l.start), end(l.start) {}
+  bool exhausted() const { return found || end >= horizon; }
+  // No crossing of this level on (start, x] (x ≤ horizon, or the horizon reached).
+  bool clear_beyond(double x) const { return found ? found->t > x : (end >= x || end >= horizon); }
+  // The whole search's windows from the start, its ends computed as first_crossing's search does,
+  // up to the first one that ends at or after `t`, `count` of them at least: (begin, end].
+  void windows_to(double t, int count) {
+    begin = end = level.start;
+    window = first_window;
+    for (int i = 0; end < horizon && (i < count || end < t); ++i) {
+      begin = end;
+      end = horizon - begin <= window ? horizon : begin + window;
+      window *= 2;
+    }
+  }
+  // The first call: the level's whole search over its first windows, to `reach` at least (its
+  // crossing there is the reference's).  Later calls: the next window, a certified search of its own.
+  void advance(double reach, int windows = 1) {
+    if (!started) {
+      started = exact = true;
+      windows_to(reach, windows);
+      found = level.search(level.start, end);
+      if (found) windows_to(found->t, 1);  // the window that holds it
+      return;
+    }
+    exact = false;
+    begin = end;
+    end = horizon - begin <= window ? horizon : begin + window;
+    window *= 2;
+    found = level.search(begin, end);
+  }
+  // The crossing as the level's whole search finds it: found again by that search (which stops
+  // there) when a window of its own found it; it must be the same crossing in the same window.
+  std::optional<Crossing> whole() const {
+    if (exact) return found;
+    const std::optional<Crossing> w = level.search(level.start, horizon);
+    if (!w || w->grazing || w->t > end || !(std::fabs(w->t - found->t) <= 1e-9 * found->t)) return std::nullopt;
+    return w;
+  }
+};
+
+// What the windows settle (`settled`: the event, or none on the whole horizon); the rest goes to
+// the sequential searches.
+struct Windowed {
+  bool settled = false;
+  std::optional<LevelEvent> event;
+};
+
+// After the first level's first stretch found nothing: both levels window by window.
+Windowed windowed_search(Track& a, Track& b, const long& samples) {
+  const long budget = CrossingOptions{}.max_intervals;
+  try {
+    for (;;) {
+      if ((a.found && a.found->grazing) || (b.found && b.found->grazing) || samples > budget) break;
+      // The second level's crossing stands when the first is clear past its window (the reference
+      // searches the second level up to the first's crossing: its windows up to that one the same).
+      if (b.found && a.clear_beyond(b.end + (b.end - b.begin) * 0x1p-20)) {
+        if (const auto w = b.whole()) return {true, LevelEvent{true, *w}};
+        break;
+      }
+      if (a.found && b.clear_beyond(a.found->t * (1 + 1e-9))) {
+        if (const auto w = a.whole()) return {true, LevelEvent{false, *w}};
+        break;
+      }
+      if (a.found && b.found) break;  // both within one window of each other: the reference decides
+      if (a.exhausted() && b.exhausted()) return {true, std::nullopt};
+      const bool first_next = !a.found && (b.found || b.exhausted() || (!a.exhausted() && a.end <= b.end));
+      (first_next ? a : b).advance((first_next ? b : a).end);
+    }
+  } catch (const SearchBudgetExhausted&) {
+    // the sequential searches give the reference's answer or its own exhausted budget
+  }
+  return {};
+}
+
+// The first level's first stretch as the reference searches it — a crossing there (or none on the
+// whole horizon) is the reference's, and the second level is then searched as the reference does
+// —, else both levels window by window, and the sequential searches where they cannot settle.
+std::optional<LevelEvent> windowed_levels(const Level& first, const Level& second, double horizon, double first_window,
+                                          const long& samples) {
+  Track a(first, horizon, first_window), b(second, horizon, first_window);
+  a.advance(-INFINITY, kFirstStretchWindows);
+  if (a.exhausted()) return with_second(a.found, second, horizon);
+  const Windowed windowed = windowed_search(a, b, samples);
+  if (windowed.settled) return windowed.event;
+  return sequential_search(first, second, horizon);
+}
+
+// The two levels, window by window when the mode has a time scale, else one after the other.
+std::optional<LevelEvent> first_of_two_levels(const Level& first, const Level& second, double horizon,
+                                              double first_window, const long& samples) {
+  if (!(first_window > 0) || !std::isfinite(first_window)) return sequential_search(first, second, horizon);
+  return windowed_levels(first, second, horizon, first_window, samples);
+}
+
+}  // namespace
+
 std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
                                         double opposite_face_change, double horizon, double position_scale) {
-  const std::optional<Crossing> opposite = first_crossing(gap_mode, sample, opposite_face_change, 0, horizon);
+  long samples = 0;
+  const auto counted = [&sample, &samples](double t) {
+    ++samples;
+    return sample(t);
+  };
+  const auto opposite = [&](double lo, double hi) { return first_crossing(gap_mode, counted, opposite_face_change, lo, hi); };
   // Return to the face left: Δx starts as O(t²) or O(t³), below rounding noise at first.
-  std::optional<Crossing> back;
   const double noise = 1e-10 * std::max(1.0, position_scale);
   const SmallVector x0 = sample(0).x;
   const std::optional<double> t0 = certified_departure(gap_mode, x0, noise);
-  if (t0)
-    back = first_crossing_after_departure(gap_mode, sample, *t0, certified_clearance(gap_mode, x0, *t0, noise),
-                                          opposite ? opposite->t : horizon);
-  if (back && (!opposite || back->t < opposite->t)) return GapEvent{GapEventKind::FaceLeft, *back, *t0};
-  if (opposite) return GapEvent{GapEventKind::OppositeFace, *opposite};
-  return std::nullopt;
+  if (!t0) {
+    const std::optional<Crossing> only = first_crossing(gap_mode, sample, opposite_face_change, 0, horizon);
+    if (only) return GapEvent{GapEventKind::OppositeFace, *only};
+    return std::nullopt;
+  }
+  const double clear = certified_clearance(gap_mode, x0, *t0, noise);
+  const auto back = [&](double lo, double hi) {
+    return first_crossing_after_departure(gap_mode, counted, *t0, std::max(clear, lo), hi);
+  };
+  const Level first{opposite, 0}, second{back, clear > *t0 ? std::min(clear, horizon) : *t0};
+  const std::optional<LevelEvent> event = first_of_two_levels(first, second, horizon, gap_mode.first_window, samples);
+  if (!event) return std::nullopt;
+  if (event->second) return GapEvent{GapEventKind::FaceLeft, event->crossing, *t0};
+  return GapEvent{GapEventKind::OppositeFace, event->crossing};
 }
 
 std::optional<GapEvent> first_gap_event_inside(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
                                                double start_gap, int face, double half, double horizon) {
-  const std::optional<Crossing> same = first_crossing(gap_mode, sample, face * half - start_gap, 0, horizon);
-  const std::optional<Crossing> opposite =
-      first_crossing(gap_mode, sample, -face * half - start_gap, 0, same ? same->t : horizon);
-  if (opposite && (!same || opposite->t < same->t)) return GapEvent{GapEventKind::OppositeFace, *opposite, 0, true};
-  if (same) return GapEvent{GapEventKind::FaceLeft, *same, 0, true};
-  return std::nullopt;
+  long samples = 0;
+  const auto counted = [&sample, &samples](double t) {
+    ++samples;
+    return sample(t);
+  };
+  const auto same = [&](double lo, double hi) { return first_crossing(gap_mode, counted, face * half - start_gap, lo, hi); };
+  const auto opposite = [&](double lo, double hi) {
+    return first_crossing(gap_mode, counted, -face * half - start_gap, lo, hi);
+  };
+  const Level first{same, 0}, second{opposite, 0};
+  const std::optional<LevelEvent> event = first_of_two_levels(first, second, horizon, gap_mode.first_window, samples);
+  if (!event) return std::nullopt;
+  if (event->second) return GapEvent{GapEventKind::OppositeFace, event->crossing, 0, true};
+  return GapEvent{GapEventKind::FaceLeft, event->crossing, 0, true};
 }
 
 std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
