@@ -157,7 +157,10 @@ class Flight {
     }
     const FreeState f = evaluator_->free_state(tau, v_);
     WitnessSample s{SmallVector(4), f.gap};
-    s.x << f.theta_m + offset_m_, f.dtheta_m, f.theta_L + offset_L_, f.dtheta_L;
+    s.x(0) = f.theta_m + offset_m_;
+    s.x(1) = f.dtheta_m;
+    s.x(2) = f.theta_L + offset_L_;
+    s.x(3) = f.dtheta_L;
     return s;
   }
 
@@ -304,6 +307,7 @@ class ClosedFormRun {
         cancellation_scale_(4096 * std::numeric_limits<double>::epsilon() * std::fabs(torque_.r(0)) *
                             std::max(1.0, std::fabs(p_.theta_R))),
         rigid_(p_.backlash <= 0),  // a rigid drive: contact for ever, no events
+        zeno_window_(zeno_window(p_, o_)),
         state_(rigid_ ? rigid_start(p_, start) : start),
         start_gap_(rigid_ || start.in_contact ? std::nullopt : start_gap),
         band_(band) {
@@ -321,7 +325,8 @@ class ClosedFormRun {
         if (!finite(state_)) return stop(SimulationStatus::NonFinite, "the state is no longer finite");
         if (events_ >= o_.max_events)
           return stop(SimulationStatus::EventLimit, event_limit_reason(o_));
-        if (auto problem = resolution_problem(p_, motion_scale(p_, state_.theta_m, state_.theta_L), "the motion"))
+        static const std::string motion = "the motion";
+        if (auto problem = resolution_problem(p_, motion_scale(p_, state_.theta_m, state_.theta_L), motion))
           return stop(SimulationStatus::Unresolved, *problem);
         const std::optional<SimulationStatus> end = state_.in_contact ? contact() : flight();
         if (end) return finish(*end);
@@ -360,7 +365,7 @@ class ClosedFormRun {
 
   std::optional<SimulationStatus> contact();
   WitnessSample torque_sample(double tau, double theta0, double omega0) const;
-  std::optional<Crossing> separation(double theta0, double omega0, double remaining) const;
+  std::optional<Crossing> separation(double theta0, double omega0, double remaining, ContactState& at_separation) const;
   std::optional<SimulationStatus> flight();
   SimulationStatus rest(const Flight& flight, double remaining, const HybridState& end);
   std::optional<SimulationStatus> impact(const detail::GapEvent& event, const HybridState& before);
@@ -382,6 +387,7 @@ class ClosedFormRun {
   std::optional<std::array<WitnessMode, 2>> free_velocities_;
   const double cancellation_scale_;  // see torque_sample
   const bool rigid_;
+  const double zeno_window_;  // zeno_window(p_, o_), once per run
   HybridState state_;
   std::optional<double> start_gap_;  // the first flight's gap x(0) when it starts inside the backlash
   const std::optional<Band> band_;  // options.sample_band in this run's frame (band_in_frame)
@@ -414,8 +420,10 @@ WitnessSample ClosedFormRun::torque_sample(double tau, double theta0, double ome
   return s;
 }
 
-// The next time Tc leaves its holding sign within `remaining` (a grazing touch keeps contact).
-std::optional<Crossing> ClosedFormRun::separation(double theta0, double omega0, double remaining) const {
+// The next time Tc leaves its holding sign within `remaining` (a grazing touch keeps contact), and
+// the contact state there (`at_separation`: one closed-form evaluation for the check below and the event).
+std::optional<Crossing> ClosedFormRun::separation(double theta0, double omega0, double remaining,
+                                                  ContactState& at_separation) const {
   const auto sample = [this, theta0, omega0](double tau) { return torque_sample(tau, theta0, omega0); };
   std::optional<Crossing> separation;
   double from = 0;
@@ -434,7 +442,7 @@ std::optional<Crossing> ClosedFormRun::separation(double theta0, double omega0, 
   // on the state, not on Tc's terms: when Fm/Jm = FL/JL the velocity term of Tc vanishes
   // identically and every genuine separation happens at θo = θR, with θ̇o far from zero.
   if (separation) {
-    const ContactState c = evaluator_.contact_state(separation->t, theta0, omega0);
+    const ContactState& c = at_separation = evaluator_.contact_state(separation->t, theta0, omega0);
     const double noise = 1024 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(p_.theta_R));
     const double rate = std::sqrt(p_.K / (p_.Jm + p_.JL));  // converts a velocity to a displacement scale
     if (std::fabs(c.theta_o - p_.theta_R) <= noise && std::fabs(c.dtheta_o) <= noise * rate) separation.reset();
@@ -451,7 +459,8 @@ std::optional<SimulationStatus> ClosedFormRun::contact() {
     const ContactState c = evaluator.contact_state(tau, theta0, omega0);
     return contact_state_on_face(p, face, c.theta_o, c.dtheta_o);
   };
-  const std::optional<Crossing> separated = separation(theta0, omega0, remaining);
+  ContactState at_separation{};
+  const std::optional<Crossing> separated = separation(theta0, omega0, remaining, at_separation);
   if (o_.track_extremes) {
     const auto vector = [this, theta0, omega0](double tau) { return torque_sample(tau, theta0, omega0).x; };
     segment_extremes(p_, &*contact_velocity_, 1, vector, at, separated ? separated->t : remaining, result_.extremes);
@@ -466,9 +475,8 @@ std::optional<SimulationStatus> ClosedFormRun::contact() {
     t_ = o_.t_end;
     return SimulationStatus::Completed;
   }
-  const HybridState at_separation = at(separated->t);
   t_ += separated->t;
-  state_ = at_separation;
+  state_ = contact_state_on_face(p_, face, at_separation.theta_o, at_separation.dtheta_o);  // at(separated->t)
   state_.in_contact = false;  // face σ is the face just left
   push_event(EventKind::Separation, false, false);
   if (o_.stop_after_separations > 0 && ++separations_ >= o_.stop_after_separations) return SimulationStatus::Completed;
@@ -484,7 +492,9 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   const Flight flight = from_line ? Flight::from_separation_line(evaluator_, state_) : Flight::from_state(p_, state_);
   const auto at = [&flight](double tau) { return flight.at(tau); };
   const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(p_, state_.dtheta_m))});
-  const auto sample = [&flight](double tau) { return flight.gap_sample(tau); };
+  // x(0) is asked by the search's first interval and by the departure: evaluated once.
+  const WitnessSample start = flight.gap_sample(0);
+  const auto sample = [&flight, &start](double tau) { return tau == 0 ? start : flight.gap_sample(tau); };
   const auto event = start_gap_ ? detail::first_gap_event_inside(gap_mode_, sample, *start_gap_, state_.face,
                                                                  p_.backlash / 2, remaining)
                                 : detail::first_gap_event(gap_mode_, sample, -state_.face * p_.backlash, remaining, scale);
@@ -574,7 +584,7 @@ std::optional<SimulationStatus> ClosedFormRun::impact(const detail::GapEvent& ev
   const bool holds = -face_hit * tc >= -1e-14 * std::max(1.0, std::fabs(tc));
   if (!holds) state_.in_contact = false;  // a bounce: the bodies part again at once
   push_event(opposite ? EventKind::Recombination : EventKind::Recontact, !holds, event.crossing.grazing);
-  const double window = zeno_window(p_, o_);
+  const double window = zeno_window_;
   if (static_cast<long long>(impacts_.add(t_, window)) >= o_.zeno_impacts) {
     result_.stop_reason = zeno_reason(o_, window);
     return SimulationStatus::Chattering;
