@@ -6,6 +6,7 @@
 #include <boost/math/tools/roots.hpp>
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -75,11 +76,14 @@ constexpr double kSampleNoise = 1e-6;
 double growth_bound(double x) {
   if (!(x > 0)) return 1;
   if (!(x <= 700)) return INFINITY;
+  // y = x/2^k with the fewest halvings that bring it to ≤ 1/4 (exact: powers of two).
   int k = 0;
   double y = x;
-  while (y > 0.25) {
-    y *= 0.5;
-    ++k;
+  if (y > 0.25) {  // x = (1 + f)·2^E (normal): k = E + 2, or E + 3 when f > 0; y in (1/8, 1/4]
+    const auto bits = std::bit_cast<std::uint64_t>(x);
+    const int E = static_cast<int>(bits >> 52) - 1023;
+    k = (bits & ((std::uint64_t{1} << 52) - 1)) == 0 ? E + 2 : E + 3;
+    y = std::bit_cast<double>(bits - (static_cast<std::uint64_t>(k) << 52));
   }
   double e = 1 + y * (1 + y * (0.5 + 0.22 * y));
   for (int i = 0; i < k; ++i) e *= e;
