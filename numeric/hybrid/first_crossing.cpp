@@ -6,9 +6,9 @@
 #include <boost/math/tools/roots.hpp>
 
 #include <array>
-#include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -80,10 +80,12 @@ double growth_bound(double x) {
   int k = 0;
   double y = x;
   if (y > 0.25) {  // x = (1 + f)·2^E (normal): k = E + 2, or E + 3 when f > 0; y in (1/8, 1/4]
-    const auto bits = std::bit_cast<std::uint64_t>(x);
+    std::uint64_t bits;  // (std::memcpy, not std::bit_cast: the explorer's libc++ has none)
+    std::memcpy(&bits, &x, sizeof bits);
     const int E = static_cast<int>(bits >> 52) - 1023;
     k = (bits & ((std::uint64_t{1} << 52) - 1)) == 0 ? E + 2 : E + 3;
-    y = std::bit_cast<double>(bits - (static_cast<std::uint64_t>(k) << 52));
+    bits -= static_cast<std::uint64_t>(k) << 52;
+    std::memcpy(&y, &bits, sizeof y);
   }
   double e = 1 + y * (1 + y * (0.5 + 0.22 * y));
   for (int i = 0; i < k; ++i) e *= e;

@@ -138,6 +138,8 @@ class Flight {
     return f;
   }
   HybridState at(double tau) const { return free_state_of(vector(tau), face_); }
+  /// at(τ) from a gap_sample(τ) already taken (the same evaluation).
+  HybridState at(const WitnessSample& sample) const { return free_state_of(sample.x, face_); }
   /// The turns of θo in (0, duration) (sample_band.hpp); −1 after a bounce (no closed form of them).
   int turns(const Parameters& p, double duration, double* out, int capacity) const {
     if (linear_) return -1;
@@ -213,6 +215,26 @@ void segment_extremes(const Parameters& p, const WitnessMode* velocity_modes, in
     }
   }
 }
+
+// The last few samples of a flight's searches, by time: the event's state when its time was sampled.
+class RecentSamples {
+ public:
+  const WitnessSample& add(double tau, WitnessSample s) {
+    const std::size_t i = next_++ % samples_.size();
+    times_[i] = tau;
+    return samples_[i] = std::move(s);
+  }
+  const WitnessSample* find(double tau) const {
+    for (std::size_t i = 0; i < samples_.size(); ++i)
+      if (times_[i] == tau) return &samples_[i];
+    return nullptr;
+  }
+
+ private:
+  std::array<WitnessSample, 8> samples_;
+  std::array<double, 8> times_ = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
+  std::size_t next_ = 0;
+};
 
 // The times of the recent impacts, for the Zeno rule: a ring that grows only when more impacts
 // than ever before fall into the window (never per event in a steady motion).
@@ -364,7 +386,7 @@ class ClosedFormRun {
   }
 
   std::optional<SimulationStatus> contact();
-  WitnessSample torque_sample(double tau, double theta0, double omega0) const;
+  WitnessSample torque_sample(double tau, double theta0, double omega0, ContactState* state = nullptr) const;
   std::optional<Crossing> separation(double theta0, double omega0, double remaining, ContactState& at_separation) const;
   std::optional<SimulationStatus> flight();
   SimulationStatus rest(const Flight& flight, double remaining, const HybridState& end);
@@ -399,8 +421,9 @@ class ClosedFormRun {
 
 // Tc = JL θ̈o + FL θ̇o along the contact segment from (θ0, ω0), with the state y = (θo, θ̇o) at τ
 // from the same closed-form evaluation: one sample of the certified witness.
-WitnessSample ClosedFormRun::torque_sample(double tau, double theta0, double omega0) const {
+WitnessSample ClosedFormRun::torque_sample(double tau, double theta0, double omega0, ContactState* state) const {
   const ContactState c = evaluator_.contact_state(tau, theta0, omega0);
+  if (state) *state = c;
   WitnessSample s{SmallVector(2), 0};
   s.x << c.theta_o, c.dtheta_o;
   // Tc = (JL K/J)(θR − θo) + (FL − JL F/J) θ̇o without the cancellation θR − θo: by
@@ -424,7 +447,13 @@ WitnessSample ClosedFormRun::torque_sample(double tau, double theta0, double ome
 // the contact state there (`at_separation`: one closed-form evaluation for the check below and the event).
 std::optional<Crossing> ClosedFormRun::separation(double theta0, double omega0, double remaining,
                                                   ContactState& at_separation) const {
-  const auto sample = [this, theta0, omega0](double tau) { return torque_sample(tau, theta0, omega0); };
+  // The last point sampled: the separation's state when the root is a sample (Halley's last step below rounding).
+  double last_tau = NAN;
+  ContactState last{};
+  const auto sample = [this, theta0, omega0, &last_tau, &last](double tau) {
+    last_tau = tau;
+    return torque_sample(tau, theta0, omega0, &last);
+  };
   std::optional<Crossing> separation;
   double from = 0;
   if (std::fabs(transmitted_torque_at(p_, theta0, omega0)) <= 1e-13 * std::max(1.0, std::fabs(omega0))) {
@@ -442,7 +471,8 @@ std::optional<Crossing> ClosedFormRun::separation(double theta0, double omega0, 
   // on the state, not on Tc's terms: when Fm/Jm = FL/JL the velocity term of Tc vanishes
   // identically and every genuine separation happens at θo = θR, with θ̇o far from zero.
   if (separation) {
-    const ContactState& c = at_separation = evaluator_.contact_state(separation->t, theta0, omega0);
+    const ContactState& c = at_separation =
+        separation->t == last_tau ? last : evaluator_.contact_state(separation->t, theta0, omega0);
     const double noise = 1024 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(p_.theta_R));
     const double rate = std::sqrt(p_.K / (p_.Jm + p_.JL));  // converts a velocity to a displacement scale
     if (std::fabs(c.theta_o - p_.theta_R) <= noise && std::fabs(c.dtheta_o) <= noise * rate) separation.reset();
@@ -492,9 +522,16 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   const Flight flight = from_line ? Flight::from_separation_line(evaluator_, state_) : Flight::from_state(p_, state_);
   const auto at = [&flight](double tau) { return flight.at(tau); };
   const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(p_, state_.dtheta_m))});
-  // x(0) is asked by the search's first interval and by the departure: evaluated once.
+  // x(0) is asked by the search's first interval and by the departure, and the event is often a
+  // point just sampled (the return search's horizon is the opposite face's crossing, both searches'
+  // is t_end): each evaluated once.
   const WitnessSample start = flight.gap_sample(0);
-  const auto sample = [&flight, &start](double tau) { return tau == 0 ? start : flight.gap_sample(tau); };
+  RecentSamples recent;
+  const auto sample = [&flight, &start, &recent](double tau) {
+    if (tau == 0) return start;
+    const WitnessSample* known = recent.find(tau);
+    return known ? *known : recent.add(tau, flight.gap_sample(tau));
+  };
   const auto event = start_gap_ ? detail::first_gap_event_inside(gap_mode_, sample, *start_gap_, state_.face,
                                                                  p_.backlash / 2, remaining)
                                 : detail::first_gap_event(gap_mode_, sample, -state_.face * p_.backlash, remaining, scale);
@@ -508,7 +545,8 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   };
   if (!event) {
     record(o_.t_end + 1e-12, at, turns);
-    const HybridState end = flight.at(remaining);
+    const WitnessSample* sampled = recent.find(remaining);
+    const HybridState end = sampled ? flight.at(*sampled) : flight.at(remaining);
     const double speed = std::max(std::fabs(end.dtheta_m), std::fabs(end.dtheta_L));
     if (speed < o_.rest_velocity) return rest(flight, remaining, end);
     state_ = end;
@@ -520,7 +558,8 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
     return SimulationStatus::Unresolved;
   }
   record(t_ + event->crossing.t + 1e-12, at, turns);
-  const HybridState before = flight.at(event->crossing.t);
+  const WitnessSample* sampled = recent.find(event->crossing.t);
+  const HybridState before = sampled ? flight.at(*sampled) : flight.at(event->crossing.t);
   t_ += event->crossing.t;
   return impact(*event, before);
 }
