@@ -28,17 +28,27 @@ WitnessMode gap_witness_mode(const LinearSegment& free_segment, double time_unit
 
 std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
                                         double opposite_face_change, double horizon, double position_scale) {
-  const std::optional<Crossing> opposite = first_crossing(gap_mode, sample, opposite_face_change, 0, horizon);
+  // x(0): the first search's first point and the departure's start, evaluated once.
+  const WitnessSample start = sample(0);
+  const auto from_start = [&sample, &start](double t) { return t == 0 ? start : sample(t); };
+  const std::optional<Crossing> opposite = first_crossing(gap_mode, from_start, opposite_face_change, 0, horizon);
   // Return to the face left: Δx starts as O(t²) or O(t³), below rounding noise at first.
   std::optional<Crossing> back;
   const double noise = 1e-10 * std::max(1.0, position_scale);
-  const SmallVector x0 = sample(0).x;
+  const SmallVector& x0 = start.x;
   const std::optional<double> t0 = certified_departure(gap_mode, x0, noise);
+  // The return search samples its horizon, the opposite face's crossing: kept as the event's state.
+  const double until = opposite ? opposite->t : horizon;
+  SmallVector at_until;
+  const auto keeping = [&sample, &at_until, until](double t) {
+    WitnessSample s = sample(t);
+    if (t == until) at_until = s.x;
+    return s;
+  };
   if (t0)
-    back = first_crossing_after_departure(gap_mode, sample, *t0, certified_clearance(gap_mode, x0, *t0, noise),
-                                          opposite ? opposite->t : horizon);
-  if (back && (!opposite || back->t < opposite->t)) return GapEvent{GapEventKind::FaceLeft, *back, *t0};
-  if (opposite) return GapEvent{GapEventKind::OppositeFace, *opposite};
+    back = first_crossing_after_departure(gap_mode, keeping, *t0, certified_clearance(gap_mode, x0, *t0, noise), until);
+  if (back && (!opposite || back->t < opposite->t)) return GapEvent{GapEventKind::FaceLeft, *back, *t0, false, {}};
+  if (opposite) return GapEvent{GapEventKind::OppositeFace, *opposite, 0, false, at_until};
   return std::nullopt;
 }
 
@@ -47,8 +57,8 @@ std::optional<GapEvent> first_gap_event_inside(const WitnessMode& gap_mode, Func
   const std::optional<Crossing> same = first_crossing(gap_mode, sample, face * half - start_gap, 0, horizon);
   const std::optional<Crossing> opposite =
       first_crossing(gap_mode, sample, -face * half - start_gap, 0, same ? same->t : horizon);
-  if (opposite && (!same || opposite->t < same->t)) return GapEvent{GapEventKind::OppositeFace, *opposite, 0, true};
-  if (same) return GapEvent{GapEventKind::FaceLeft, *same, 0, true};
+  if (opposite && (!same || opposite->t < same->t)) return GapEvent{GapEventKind::OppositeFace, *opposite, 0, true, {}};
+  if (same) return GapEvent{GapEventKind::FaceLeft, *same, 0, true, {}};
   return std::nullopt;
 }
 

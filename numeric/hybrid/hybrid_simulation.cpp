@@ -103,14 +103,15 @@ bool finite(const HybridState& s) {
   return std::isfinite(s.theta_m) && std::isfinite(s.theta_L) && std::isfinite(s.dtheta_m) && std::isfinite(s.dtheta_L);
 }
 
-HybridState free_state_of(const SmallVector& x, int face) {
+// x = (θm, θ̇m, θL, θ̇L)
+HybridState free_state_of(const double* x, int face) {
   HybridState h;
   h.in_contact = false;
   h.face = face;
-  h.theta_m = x(0);
-  h.dtheta_m = x(1);
-  h.theta_L = x(2);
-  h.dtheta_L = x(3);
+  h.theta_m = x[0];
+  h.dtheta_m = x[1];
+  h.theta_L = x[2];
+  h.dtheta_L = x[3];
   return h;
 }
 
@@ -137,9 +138,9 @@ class Flight {
     f.face_ = start.face;
     return f;
   }
-  HybridState at(double tau) const { return free_state_of(vector(tau), face_); }
-  /// at(τ) from a gap_sample(τ) already taken (the same evaluation).
-  HybridState at(const WitnessSample& sample) const { return free_state_of(sample.x, face_); }
+  HybridState at(double tau) const { return free_state_of(vector(tau).data(), face_); }
+  /// at(τ) from the x of a gap_sample(τ) already taken (the same evaluation).
+  HybridState at(const double* x) const { return free_state_of(x, face_); }
   /// The turns of θo in (0, duration) (sample_band.hpp); −1 after a bounce (no closed form of them).
   int turns(const Parameters& p, double duration, double* out, int capacity) const {
     if (linear_) return -1;
@@ -215,26 +216,6 @@ void segment_extremes(const Parameters& p, const WitnessMode* velocity_modes, in
     }
   }
 }
-
-// The last few samples of a flight's searches, by time: the event's state when its time was sampled.
-class RecentSamples {
- public:
-  const WitnessSample& add(double tau, WitnessSample s) {
-    const std::size_t i = next_++ % samples_.size();
-    times_[i] = tau;
-    return samples_[i] = std::move(s);
-  }
-  const WitnessSample* find(double tau) const {
-    for (std::size_t i = 0; i < samples_.size(); ++i)
-      if (times_[i] == tau) return &samples_[i];
-    return nullptr;
-  }
-
- private:
-  std::array<WitnessSample, 8> samples_;
-  std::array<double, 8> times_ = {NAN, NAN, NAN, NAN, NAN, NAN, NAN, NAN};
-  std::size_t next_ = 0;
-};
 
 // The times of the recent impacts, for the Zeno rule: a ring that grows only when more impacts
 // than ever before fall into the window (never per event in a steady motion).
@@ -522,16 +503,7 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   const Flight flight = from_line ? Flight::from_separation_line(evaluator_, state_) : Flight::from_state(p_, state_);
   const auto at = [&flight](double tau) { return flight.at(tau); };
   const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(p_, state_.dtheta_m))});
-  // x(0) is asked by the search's first interval and by the departure, and the event is often a
-  // point just sampled (the return search's horizon is the opposite face's crossing, both searches'
-  // is t_end): each evaluated once.
-  const WitnessSample start = flight.gap_sample(0);
-  RecentSamples recent;
-  const auto sample = [&flight, &start, &recent](double tau) {
-    if (tau == 0) return start;
-    const WitnessSample* known = recent.find(tau);
-    return known ? *known : recent.add(tau, flight.gap_sample(tau));
-  };
+  const auto sample = [&flight](double tau) { return flight.gap_sample(tau); };
   const auto event = start_gap_ ? detail::first_gap_event_inside(gap_mode_, sample, *start_gap_, state_.face,
                                                                  p_.backlash / 2, remaining)
                                 : detail::first_gap_event(gap_mode_, sample, -state_.face * p_.backlash, remaining, scale);
@@ -545,8 +517,7 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   };
   if (!event) {
     record(o_.t_end + 1e-12, at, turns);
-    const WitnessSample* sampled = recent.find(remaining);
-    const HybridState end = sampled ? flight.at(*sampled) : flight.at(remaining);
+    const HybridState end = flight.at(remaining);
     const double speed = std::max(std::fabs(end.dtheta_m), std::fabs(end.dtheta_L));
     if (speed < o_.rest_velocity) return rest(flight, remaining, end);
     state_ = end;
@@ -558,8 +529,7 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
     return SimulationStatus::Unresolved;
   }
   record(t_ + event->crossing.t + 1e-12, at, turns);
-  const WitnessSample* sampled = recent.find(event->crossing.t);
-  const HybridState before = sampled ? flight.at(*sampled) : flight.at(event->crossing.t);
+  const HybridState before = event->x.size() == 4 ? flight.at(event->x.data()) : flight.at(event->crossing.t);
   t_ += event->crossing.t;
   return impact(*event, before);
 }
