@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -75,15 +76,42 @@ constexpr double kSampleNoise = 1e-6;
 double growth_bound(double x) {
   if (!(x > 0)) return 1;
   if (!(x <= 700)) return INFINITY;
+  // y = x/2^k with the fewest halvings that bring it to ≤ 1/4 (exact: powers of two).
   int k = 0;
   double y = x;
-  while (y > 0.25) {
-    y *= 0.5;
-    ++k;
+  if (y > 0.25) {  // x = (1 + f)·2^E (normal): k = E + 2, or E + 3 when f > 0; y in (1/8, 1/4]
+    std::uint64_t bits;  // (std::memcpy, not std::bit_cast: the explorer's libc++ has none)
+    std::memcpy(&bits, &x, sizeof bits);
+    const int E = static_cast<int>(bits >> 52) - 1023;
+    k = (bits & ((std::uint64_t{1} << 52) - 1)) == 0 ? E + 2 : E + 3;
+    bits -= static_cast<std::uint64_t>(k) << 52;
+    std::memcpy(&y, &bits, sizeof y);
   }
   double e = 1 + y * (1 + y * (0.5 + 0.22 * y));
   for (int i = 0; i < k; ++i) e *= e;
   return e * (1 + 1e-14 * (1 + x));
+}
+
+// The mode's products for its sizes, unrolled, with Eigen's own order of operations for these
+// expressions (bit for bit the same: a dot product of 4 sums the products pairwise,
+// (a0b0 + a2b2) + (a1b1 + a3b3); A x sums each row's products left to right, then adds c).
+template <int N>
+[[gnu::always_inline]] inline double dot_of(const SmallRow& r, const double* x) {
+  if constexpr (N == 4) return (r(0) * x[0] + r(2) * x[2]) + (r(1) * x[1] + r(3) * x[3]);
+  else return r(0) * x[0] + r(1) * x[1];
+}
+
+// z = A x + c (x' at x) into z; returns ‖x‖∞.
+template <int N>
+[[gnu::always_inline]] inline double rate_of(const WitnessMode& m, const double* x, double* z) {
+  double size = 0;
+  for (int i = 0; i < N; ++i) {
+    double zi = m.A(i, 0) * x[0];
+    for (int j = 1; j < N; ++j) zi += m.A(i, j) * x[j];
+    z[i] = zi + m.c(i);
+    size = std::max(size, std::fabs(x[i]));
+  }
+  return size;
 }
 
 // A witness on a mode, sampled through one closed-form evaluation per point.
@@ -107,31 +135,30 @@ class Sampler {
     const SmallVector z = m_.A * s.x + m_.c;  // x' obeys z' = A z
     return {t, w, w1, w2, rate_norm(z), s.x.cwiseAbs().maxCoeff()};
   }
-  // at() for the modes' sizes, unrolled, with Eigen's own order of operations for these
-  // expressions (bit for bit the same: a dot product of 4 sums the products pairwise,
-  // (a0b0 + a2b2) + (a1b1 + a3b3); A x sums each row's products left to right, then adds c).
   template <int N>
   Sample fixed_size(double t, double w, const double* x) const {
-    const auto dot = [x](const SmallRow& r) {
-      if constexpr (N == 4) return (r(0) * x[0] + r(2) * x[2]) + (r(1) * x[1] + r(3) * x[3]);
-      else return r(0) * x[0] + r(1) * x[1];
-    };
-    double rate = 0, size = 0;
+    double z[N];
+    const double size = rate_of<N>(m_, x, z);
+    double rate = 0;
     for (int i = 0; i < N; ++i) {
-      double z = m_.A(i, 0) * x[0];
-      for (int j = 1; j < N; ++j) z += m_.A(i, j) * x[j];
-      z += m_.c(i);
-      const double scaled = std::fabs(z * m_.scale(i));
+      const double scaled = std::fabs(z[i] * m_.scale(i));
       rate = i == 0 ? scaled : std::max(rate, scaled);
-      size = std::max(size, std::fabs(x[i]));
     }
-    return {t, w, dot(m_.eA) + m_.ec, dot(m_.eA2) + m_.eAc, rate, size};
+    return {t, w, dot_of<N>(m_.eA, x) + m_.ec, dot_of<N>(m_.eA2, x) + m_.eAc, rate, size};
   }
 
   double value(double t) const { return sample_(t).value - level_; }
 
   // An upper bound on e^{μ⁺h} (growth_bound): a few flops, no exp, for the lengths of a search.
-  double growth(double h) const { return growth_bound(std::max(0.0, m_.mu_A) * h); }
+  // The last length asked is remembered: an interval's halving test and its bounds, and the two
+  // halves of a bisection, ask for the same h (the same bits, computed once).
+  double growth(double h) const {
+    if (h != last_h_) {
+      last_h_ = h;
+      last_growth_ = growth_bound(std::max(0.0, m_.mu_A) * h);
+    }
+    return last_growth_;
+  }
 
   // sup |w'''| on [a.t, a.t + h]: w''' = eA² z = (eA² D⁻¹)(D z) and ‖D z(t)‖∞ ≤
   // e^{μ∞(DAD⁻¹)(t−a)} ‖D z(a)‖∞ (the supremum of e^{μ s} over s ∈ [0, h] is 1 when μ ≤ 0).
@@ -168,6 +195,7 @@ class Sampler {
   const WitnessMode& m_;
   FunctionRef<WitnessSample(double)> sample_;
   double level_;
+  mutable double last_h_ = NAN, last_growth_ = NAN;  // growth(): NaN never equals a length
 };
 
 bool same_sign(double x, double y) { return (x > 0 && y > 0) || (x < 0 && y < 0); }
@@ -367,6 +395,7 @@ WitnessMode::WitnessMode(const SmallMatrix& A_, const SmallVector& c_, const Sma
   norm_e_plain = e.cwiseAbs().sum();
   norm_eA = eA.cwiseAbs().sum();
   norm_A = (scale.asDiagonal() * A).cwiseAbs().rowwise().sum().maxCoeff();
+  norm_A_plain = A.cwiseAbs().rowwise().sum().maxCoeff();
   inverse_scale = scale.cwiseInverse().maxCoeff();
 }
 
@@ -375,12 +404,41 @@ void WitnessMode::set_forcing(const SmallVector& forcing) {
   ec = e.dot(c);
   eAc = eA.dot(c);
   eA2c = eA2.dot(c);
+  norm_c = c.cwiseAbs().maxCoeff();
 }
 
+namespace {
+
+// At a start x0: ‖D x'(0)‖∞ (‖D x'(t)‖∞ ≤ e^{μ t} of it), w''(0) = eA x'(0), w'''(0) = eA² x'(0) and
+// ‖x0‖∞, with x'(0) = A x0 + c — for the modes' sizes by the Sampler's unrolled products (Eigen's
+// order of operations, the same bits), otherwise by Eigen.
+struct StartRates {
+  double z0, second, third, x_size;
+};
+
+template <int N>
+StartRates start_rates_of(const WitnessMode& W, const double* x) {
+  double z[N];
+  const double size = rate_of<N>(W, x, z);
+  double z0 = 0;
+  for (int i = 0; i < N; ++i) z0 = std::max(z0, std::fabs(z[i] * W.scale(i)));
+  return {z0, dot_of<N>(W.eA, z), dot_of<N>(W.eA2, z), size};
+}
+
+StartRates start_rates(const WitnessMode& W, const SmallVector& x0) {
+  if (x0.size() == 4 && W.A.rows() == 4) return start_rates_of<4>(W, x0.data());
+  if (x0.size() == 2 && W.A.rows() == 2) return start_rates_of<2>(W, x0.data());
+  const SmallVector z = W.A * x0 + W.c;
+  return {z.cwiseProduct(W.scale).cwiseAbs().maxCoeff(), W.eA.dot(z), W.eA2.dot(z), x0.cwiseAbs().maxCoeff()};
+}
+
+}  // namespace
+
 std::optional<double> certified_departure(const WitnessMode& W, const SmallVector& x0, double noise) {
-  const double z0 = (W.A * x0 + W.c).cwiseProduct(W.scale).cwiseAbs().maxCoeff();  // ‖D x'(0)‖∞, ‖D x'(t)‖∞ ≤ e^{μ t} z0
-  const double second = W.eA.dot(W.A * x0 + W.c);   // w''(0) = eA x'(0)
-  const double third = W.eA2.dot(W.A * x0 + W.c);   // w'''(0) = eA² x'(0)
+  const StartRates r = start_rates(W, x0);
+  const double z0 = r.z0;          // ‖D x'(0)‖∞, ‖D x'(t)‖∞ ≤ e^{μ t} z0
+  const double second = r.second;  // w''(0) = eA x'(0)
+  const double third = r.third;    // w'''(0) = eA² x'(0)
   const double scale = std::max(std::fabs(second), 1e-300);
   const double growth = std::max(0.0, W.mu_A);  // ‖D x'(t)‖∞ ≤ e^{μ∞(DAD⁻¹) t} z0
   // w'' dominant: |w''(0)| > t0 sup|w'''|, sup|w'''| ≤ ‖eA²‖ e^{μ t0} z0.
@@ -407,12 +465,11 @@ double last_within(double first_guess, double t0, double bound, double growth, d
 }
 
 double certified_clearance(const WitnessMode& W, const SmallVector& x0, double t0, double noise) {
-  const SmallVector z = W.A * x0 + W.c;
-  const double z0 = z.cwiseProduct(W.scale).cwiseAbs().maxCoeff();
-  const double second = std::fabs(W.eA.dot(z)), third = std::fabs(W.eA2.dot(z));
+  const StartRates r = start_rates(W, x0);
+  const double z0 = r.z0;
+  const double second = std::fabs(r.second), third = std::fabs(r.third);
   // The computed w''(0) is within `rounding` of the exact one (a million times its ulps).
-  const double rounding = kSampleNoise * W.norm_eA *
-                          (W.A.cwiseAbs().rowwise().sum().maxCoeff() * x0.cwiseAbs().maxCoeff() + W.c.cwiseAbs().maxCoeff());
+  const double rounding = kSampleNoise * W.norm_eA * (W.norm_A_plain * r.x_size + W.norm_c);
   const double growth = std::max(0.0, W.mu_A);
   if (second > 1e-12 * std::max(1.0, z0) && quadratic_resolved(second, third, W.time_unit)) {
     // w'' leads (certified_departure's first case): |w(t) − w''(0)t²/2| ≤ sup|w'''| t³/6, so

@@ -181,30 +181,42 @@ std::optional<LevelEvent> first_of_two_levels(const Level& first, const Level& s
 
 std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
                                         double opposite_face_change, double horizon, double position_scale) {
+  // x(0): the searches' first point and the departure's start, evaluated once.  The return search
+  // samples its horizon, the opposite face's crossing when it is searched up to one: that sample
+  // is kept as the event's state (`watch`: the horizon of the return search last started).
+  const WitnessSample start = sample(0);
   long samples = 0;
-  const auto counted = [&sample, &samples](double t) {
+  double watch = -1;
+  SmallVector at_watch;
+  const auto counted = [&sample, &samples, &start, &watch, &at_watch](double t) {
     ++samples;
-    return sample(t);
+    if (t == 0) return start;
+    WitnessSample s = sample(t);
+    if (t == watch) at_watch = s.x;
+    return s;
   };
   const auto opposite = [&](double lo, double hi) { return first_crossing(gap_mode, counted, opposite_face_change, lo, hi); };
   // Return to the face left: Δx starts as O(t²) or O(t³), below rounding noise at first.
   const double noise = 1e-10 * std::max(1.0, position_scale);
-  const SmallVector x0 = sample(0).x;
+  const SmallVector& x0 = start.x;
   const std::optional<double> t0 = certified_departure(gap_mode, x0, noise);
   if (!t0) {
-    const std::optional<Crossing> only = first_crossing(gap_mode, sample, opposite_face_change, 0, horizon);
-    if (only) return GapEvent{GapEventKind::OppositeFace, *only};
+    const std::optional<Crossing> only = first_crossing(gap_mode, counted, opposite_face_change, 0, horizon);
+    if (only) return GapEvent{GapEventKind::OppositeFace, *only, 0, false, {}};
     return std::nullopt;
   }
   const double clear = certified_clearance(gap_mode, x0, *t0, noise);
   const auto back = [&](double lo, double hi) {
+    watch = hi;
+    at_watch.resize(0);
     return first_crossing_after_departure(gap_mode, counted, *t0, std::max(clear, lo), hi);
   };
   const Level first{opposite, 0}, second{back, clear > *t0 ? std::min(clear, horizon) : *t0};
   const std::optional<LevelEvent> event = first_of_two_levels(first, second, horizon, gap_mode.first_window, samples);
   if (!event) return std::nullopt;
-  if (event->second) return GapEvent{GapEventKind::FaceLeft, event->crossing, *t0};
-  return GapEvent{GapEventKind::OppositeFace, event->crossing};
+  if (event->second) return GapEvent{GapEventKind::FaceLeft, event->crossing, *t0, false, {}};
+  const bool sampled_there = watch == event->crossing.t && at_watch.size() > 0;
+  return GapEvent{GapEventKind::OppositeFace, event->crossing, 0, false, sampled_there ? at_watch : SmallVector{}};
 }
 
 std::optional<GapEvent> first_gap_event_inside(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
@@ -221,8 +233,8 @@ std::optional<GapEvent> first_gap_event_inside(const WitnessMode& gap_mode, Func
   const Level first{same, 0}, second{opposite, 0};
   const std::optional<LevelEvent> event = first_of_two_levels(first, second, horizon, gap_mode.first_window, samples);
   if (!event) return std::nullopt;
-  if (event->second) return GapEvent{GapEventKind::OppositeFace, event->crossing, 0, true};
-  return GapEvent{GapEventKind::FaceLeft, event->crossing, 0, true};
+  if (event->second) return GapEvent{GapEventKind::OppositeFace, event->crossing, 0, true, {}};
+  return GapEvent{GapEventKind::FaceLeft, event->crossing, 0, true, {}};
 }
 
 std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,

@@ -17,6 +17,7 @@ struct GapEvent {
   Crossing crossing;
   double departure = 0;  ///< FaceLeft: the certified departure t0, w ≠ 0 on (0, t0], the search's start
   bool from_inside = false;  ///< the flight started strictly inside the backlash (no face left, no departure)
+  SmallVector x;  ///< x at the crossing when a search sampled it there (the event's state, not evaluated again); else empty
 };
 
 /// The witness of the gap change Δx = θL − θm − Δx(0) − level of a free flight.

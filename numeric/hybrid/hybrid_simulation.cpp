@@ -103,14 +103,15 @@ bool finite(const HybridState& s) {
   return std::isfinite(s.theta_m) && std::isfinite(s.theta_L) && std::isfinite(s.dtheta_m) && std::isfinite(s.dtheta_L);
 }
 
-HybridState free_state_of(const SmallVector& x, int face) {
+// x = (θm, θ̇m, θL, θ̇L)
+HybridState free_state_of(const double* x, int face) {
   HybridState h;
   h.in_contact = false;
   h.face = face;
-  h.theta_m = x(0);
-  h.dtheta_m = x(1);
-  h.theta_L = x(2);
-  h.dtheta_L = x(3);
+  h.theta_m = x[0];
+  h.dtheta_m = x[1];
+  h.theta_L = x[2];
+  h.dtheta_L = x[3];
   return h;
 }
 
@@ -137,7 +138,9 @@ class Flight {
     f.face_ = start.face;
     return f;
   }
-  HybridState at(double tau) const { return free_state_of(vector(tau), face_); }
+  HybridState at(double tau) const { return free_state_of(vector(tau).data(), face_); }
+  /// at(τ) from the x of a gap_sample(τ) already taken (the same evaluation).
+  HybridState at(const double* x) const { return free_state_of(x, face_); }
   /// The turns of θo in (0, duration) (sample_band.hpp); −1 after a bounce (no closed form of them).
   int turns(const Parameters& p, double duration, double* out, int capacity) const {
     if (linear_) return -1;
@@ -157,7 +160,10 @@ class Flight {
     }
     const FreeState f = evaluator_->free_state(tau, v_);
     WitnessSample s{SmallVector(4), f.gap};
-    s.x << f.theta_m + offset_m_, f.dtheta_m, f.theta_L + offset_L_, f.dtheta_L;
+    s.x(0) = f.theta_m + offset_m_;
+    s.x(1) = f.dtheta_m;
+    s.x(2) = f.theta_L + offset_L_;
+    s.x(3) = f.dtheta_L;
     return s;
   }
 
@@ -304,6 +310,7 @@ class ClosedFormRun {
         cancellation_scale_(4096 * std::numeric_limits<double>::epsilon() * std::fabs(torque_.r(0)) *
                             std::max(1.0, std::fabs(p_.theta_R))),
         rigid_(p_.backlash <= 0),  // a rigid drive: contact for ever, no events
+        zeno_window_(zeno_window(p_, o_)),
         state_(rigid_ ? rigid_start(p_, start) : start),
         start_gap_(rigid_ || start.in_contact ? std::nullopt : start_gap),
         band_(band) {
@@ -321,7 +328,8 @@ class ClosedFormRun {
         if (!finite(state_)) return stop(SimulationStatus::NonFinite, "the state is no longer finite");
         if (events_ >= o_.max_events)
           return stop(SimulationStatus::EventLimit, event_limit_reason(o_));
-        if (auto problem = resolution_problem(p_, motion_scale(p_, state_.theta_m, state_.theta_L), "the motion"))
+        static const std::string motion = "the motion";
+        if (auto problem = resolution_problem(p_, motion_scale(p_, state_.theta_m, state_.theta_L), motion))
           return stop(SimulationStatus::Unresolved, *problem);
         const std::optional<SimulationStatus> end = state_.in_contact ? contact() : flight();
         if (end) return finish(*end);
@@ -359,8 +367,8 @@ class ClosedFormRun {
   }
 
   std::optional<SimulationStatus> contact();
-  WitnessSample torque_sample(double tau, double theta0, double omega0) const;
-  std::optional<Crossing> separation(double theta0, double omega0, double remaining) const;
+  WitnessSample torque_sample(double tau, double theta0, double omega0, ContactState* state = nullptr) const;
+  std::optional<Crossing> separation(double theta0, double omega0, double remaining, ContactState& at_separation) const;
   std::optional<SimulationStatus> flight();
   SimulationStatus rest(const Flight& flight, double remaining, const HybridState& end);
   std::optional<SimulationStatus> impact(const detail::GapEvent& event, const HybridState& before);
@@ -382,6 +390,7 @@ class ClosedFormRun {
   std::optional<std::array<WitnessMode, 2>> free_velocities_;
   const double cancellation_scale_;  // see torque_sample
   const bool rigid_;
+  const double zeno_window_;  // zeno_window(p_, o_), once per run
   HybridState state_;
   std::optional<double> start_gap_;  // the first flight's gap x(0) when it starts inside the backlash
   const std::optional<Band> band_;  // options.sample_band in this run's frame (band_in_frame)
@@ -393,8 +402,9 @@ class ClosedFormRun {
 
 // Tc = JL θ̈o + FL θ̇o along the contact segment from (θ0, ω0), with the state y = (θo, θ̇o) at τ
 // from the same closed-form evaluation: one sample of the certified witness.
-WitnessSample ClosedFormRun::torque_sample(double tau, double theta0, double omega0) const {
+WitnessSample ClosedFormRun::torque_sample(double tau, double theta0, double omega0, ContactState* state) const {
   const ContactState c = evaluator_.contact_state(tau, theta0, omega0);
+  if (state) *state = c;
   WitnessSample s{SmallVector(2), 0};
   s.x << c.theta_o, c.dtheta_o;
   // Tc = (JL K/J)(θR − θo) + (FL − JL F/J) θ̇o without the cancellation θR − θo: by
@@ -414,9 +424,17 @@ WitnessSample ClosedFormRun::torque_sample(double tau, double theta0, double ome
   return s;
 }
 
-// The next time Tc leaves its holding sign within `remaining` (a grazing touch keeps contact).
-std::optional<Crossing> ClosedFormRun::separation(double theta0, double omega0, double remaining) const {
-  const auto sample = [this, theta0, omega0](double tau) { return torque_sample(tau, theta0, omega0); };
+// The next time Tc leaves its holding sign within `remaining` (a grazing touch keeps contact), and
+// the contact state there (`at_separation`: one closed-form evaluation for the check below and the event).
+std::optional<Crossing> ClosedFormRun::separation(double theta0, double omega0, double remaining,
+                                                  ContactState& at_separation) const {
+  // The last point sampled: the separation's state when the root is a sample (Halley's last step below rounding).
+  double last_tau = NAN;
+  ContactState last{};
+  const auto sample = [this, theta0, omega0, &last_tau, &last](double tau) {
+    last_tau = tau;
+    return torque_sample(tau, theta0, omega0, &last);
+  };
   std::optional<Crossing> separation;
   double from = 0;
   if (std::fabs(transmitted_torque_at(p_, theta0, omega0)) <= 1e-13 * std::max(1.0, std::fabs(omega0))) {
@@ -434,7 +452,8 @@ std::optional<Crossing> ClosedFormRun::separation(double theta0, double omega0, 
   // on the state, not on Tc's terms: when Fm/Jm = FL/JL the velocity term of Tc vanishes
   // identically and every genuine separation happens at θo = θR, with θ̇o far from zero.
   if (separation) {
-    const ContactState c = evaluator_.contact_state(separation->t, theta0, omega0);
+    const ContactState& c = at_separation =
+        separation->t == last_tau ? last : evaluator_.contact_state(separation->t, theta0, omega0);
     const double noise = 1024 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::fabs(p_.theta_R));
     const double rate = std::sqrt(p_.K / (p_.Jm + p_.JL));  // converts a velocity to a displacement scale
     if (std::fabs(c.theta_o - p_.theta_R) <= noise && std::fabs(c.dtheta_o) <= noise * rate) separation.reset();
@@ -451,7 +470,8 @@ std::optional<SimulationStatus> ClosedFormRun::contact() {
     const ContactState c = evaluator.contact_state(tau, theta0, omega0);
     return contact_state_on_face(p, face, c.theta_o, c.dtheta_o);
   };
-  const std::optional<Crossing> separated = separation(theta0, omega0, remaining);
+  ContactState at_separation{};
+  const std::optional<Crossing> separated = separation(theta0, omega0, remaining, at_separation);
   if (o_.track_extremes) {
     const auto vector = [this, theta0, omega0](double tau) { return torque_sample(tau, theta0, omega0).x; };
     segment_extremes(p_, &*contact_velocity_, 1, vector, at, separated ? separated->t : remaining, result_.extremes);
@@ -466,9 +486,8 @@ std::optional<SimulationStatus> ClosedFormRun::contact() {
     t_ = o_.t_end;
     return SimulationStatus::Completed;
   }
-  const HybridState at_separation = at(separated->t);
   t_ += separated->t;
-  state_ = at_separation;
+  state_ = contact_state_on_face(p_, face, at_separation.theta_o, at_separation.dtheta_o);  // at(separated->t)
   state_.in_contact = false;  // face σ is the face just left
   push_event(EventKind::Separation, false, false);
   if (o_.stop_after_separations > 0 && ++separations_ >= o_.stop_after_separations) return SimulationStatus::Completed;
@@ -510,7 +529,7 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
     return SimulationStatus::Unresolved;
   }
   record(t_ + event->crossing.t + 1e-12, at, turns);
-  const HybridState before = flight.at(event->crossing.t);
+  const HybridState before = event->x.size() == 4 ? flight.at(event->x.data()) : flight.at(event->crossing.t);
   t_ += event->crossing.t;
   return impact(*event, before);
 }
@@ -574,7 +593,7 @@ std::optional<SimulationStatus> ClosedFormRun::impact(const detail::GapEvent& ev
   const bool holds = -face_hit * tc >= -1e-14 * std::max(1.0, std::fabs(tc));
   if (!holds) state_.in_contact = false;  // a bounce: the bodies part again at once
   push_event(opposite ? EventKind::Recombination : EventKind::Recontact, !holds, event.crossing.grazing);
-  const double window = zeno_window(p_, o_);
+  const double window = zeno_window_;
   if (static_cast<long long>(impacts_.add(t_, window)) >= o_.zeno_impacts) {
     result_.stop_reason = zeno_reason(o_, window);
     return SimulationStatus::Chattering;

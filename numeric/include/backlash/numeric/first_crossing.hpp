@@ -117,6 +117,7 @@ struct WitnessMode {
   double mu_A;           ///< μ∞(D A D⁻¹), the growth rate of ‖D x'‖∞
   double norm_e, norm_eA2, norm_eA3;  ///< ‖eᵀD⁻¹‖₁, ‖eᵀA²D⁻¹‖₁, ‖eᵀA³D⁻¹‖₁
   double norm_e_plain, norm_eA, norm_A;  ///< ‖eᵀ‖₁, ‖eᵀA‖₁, ‖D A‖∞ (rounding scales)
+  double norm_A_plain, norm_c;           ///< ‖A‖∞, ‖c‖∞ (the rounding of w''(0) at a departure)
   double inverse_scale;  ///< max 1/D_i
   double time_unit;  ///< as LinearWitness::time_unit
   double first_window;  ///< the length of a search's first window (the mode's time scale), s
