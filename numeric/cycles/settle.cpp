@@ -112,7 +112,8 @@ class CycleCertificate {
     if (d > next_try_ || e.after.face != (e.dtheta_o > 0 ? -1 : +1)) return false;
     next_try_ = d / 2;  // a failed try waits for the motion to come twice as close
     // r: |u − v*| and a few ulps more, so that I holds u whatever the rounding of v* ± r.
-    return holds(e.dtheta_o > 0 ? 1.0 : -1.0, d * (1 + 1e-9) + 8 * std::numeric_limits<double>::epsilon() * v);
+    const double sign = e.dtheta_o > 0 ? 1.0 : -1.0, r = d * (1 + 1e-9) + 8 * std::numeric_limits<double>::epsilon() * v;
+    return one_sided_ ? holds_one_sided(sign, u > v ? r : -r) : holds(sign, r);
   }
 
  private:
@@ -124,6 +125,17 @@ class CycleCertificate {
     if (std::fabs(g_low - v) > r || std::fabs(g_high - v) > r) return false;
     if ((g_high - g_low) * cycle_.half_map_derivative < 0) return false;
     return inside(low.extremes) && inside(high.extremes);
+  }
+  // g'(v*) > 0 (settle.hpp): I = [v*, v* + r] or [v* − r, v*] (`signed_r`'s sign: u's side of v*),
+  // whose end v* is the cycle itself (Newton's half cycle: one recombination that holds, then the
+  // separation); only the other end is simulated, and g of it must lie in I.
+  bool holds_one_sided(double sign, double signed_r) const {
+    const double v = cycle_.separation_velocity;
+    const HalfCycle end = half_cycle(evaluator_, sign * (v + signed_r), true);
+    if (!plain(end)) return false;
+    const double moved = sign * end.v_out - v;  // g(end) − v*: toward v* (same sign as signed_r), no farther than r
+    if (moved * signed_r < 0 || std::fabs(moved) > std::fabs(signed_r)) return false;
+    return inside(end.extremes) && inside(Extremes{cycle_.theta_o_min, cycle_.theta_o_max});
   }
   // One recombination that holds, then the separation.
   static bool plain(const HalfCycle& h) {
@@ -140,6 +152,8 @@ class CycleCertificate {
   }
   const ValidatedEvaluator& evaluator_;
   const LimitCycle& cycle_;
+  // Newton's cycle (its half cycle is plain) with g'(v*) > 0: the motion approaches v* from one side.
+  const bool one_sided_ = !cycle_.survey_fallback && cycle_.half_map_derivative > 0;
   const SimulationOptions::SampleBand band_;
   double margin_ = 0;
   double next_try_ = 0;  // |u − v*| at which the next try is made

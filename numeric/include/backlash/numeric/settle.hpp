@@ -24,7 +24,10 @@
 // I = [v* − r, v* + r] around the cycle's v* (r = |u − v*|) that g maps into itself (checked at
 // I's ends: same events, one recombination and a separation, and g(ends) in I, in the order of
 // g'(v*)'s sign) and whose ends' half cycles keep θo (and its mirror image about θR) inside the
-// band by the sample band's margin.  g, and θo's extremes over a half cycle, are ASSUMED monotone
+// band by the sample band's margin.  When g'(v*) > 0 (Newton's cycle: the speeds approach v* from
+// u's side, without alternating) I is the one-sided [v*, u'] (or [u', v*]), u' = v* ± r on u's
+// side: its end v* is the cycle itself (its extremes inside the band by the margin), so one half
+// cycle is simulated, from u', and g(u') must lie in I.  g, and θo's extremes over a half cycle, are ASSUMED monotone
 // on I (they are smooth there, with |g'(v*)| < 1; the checks at I's ends and at v* agree with
 // it, but nothing proves it between them): this stop is a check, not a certificate.  Under that
 // assumption every later sample lies inside the band, so the settle time and the status are
