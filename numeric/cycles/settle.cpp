@@ -1,6 +1,7 @@
 // settle.cpp — the settle time of a step response (settle.hpp; docs/design.md, "Design-space maps").
 #include "backlash/numeric/settle.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -159,33 +160,54 @@ class CycleCertificate {
   double next_try_ = 0;  // |u − v*| at which the next try is made
 };
 
-// Thrown from the run's event sink once every later θo is certified inside the moving band:
-// the run ends there (its samples so far are those of the whole run up to that time).
+// Thrown from the run's event sink once every later θo is certified inside the moving band at a
+// separation other than the expected one: the run ends there (its samples so far are those of the
+// whole run up to that time).
 struct InsideFromHere {};
+
+using Certificate = std::function<bool(const SimulationEvent&)>;
 
 // The settle time from `simulate(options)`: with samples left out by the moving band, again with
 // all of them when that run stopped at rest after leaving some out (its band is θ∞'s).  With a
 // `certificate` (nominal runs toward a stable cycle), the first run stops at the separation from
-// which the rest of the motion is certified inside the band (CycleCertificate).
+// which the rest of the motion is certified inside the band (CycleCertificate): at the
+// `expected` one (SettleOptions::expected_separation) the simulator ends it there
+// (stop_after_separations), at any other the event sink unwinds it.  A run that reached the
+// expected separation uncertified is run again from the start, its certificate skipping the
+// separations it has already judged: the same tries, the same answer.
 template <class Simulate>
 Settle settled(const Simulate& simulate, const Parameters& p, const LimitCycle& cycle, const SettleOptions& o,
-               const std::function<bool(const SimulationEvent&)>& certificate = {}) {
+               const Certificate& certificate = {}, long expected = 0) {
   std::vector<Sample> theta_o;
   SimulationOptions first = sampled(o, theta_o, moving_band(p, cycle, o.fraction * std::fabs(o.step)));
   double stopped = NAN;
-  if (certificate)
-    first.event_sink = [&certificate, &stopped](const SimulationEvent& e) {
+  long separations = 0;
+  if (certificate) {
+    first.stop_after_separations = expected;
+    first.event_sink = [&certificate, &stopped, &separations, expected](const SimulationEvent& e) {
+      separations += e.kind == EventKind::Separation;
       if (!certificate(e)) return;
       stopped = e.t;
-      throw InsideFromHere{};
+      if (separations != expected) throw InsideFromHere{};
     };
+  }
   SimulationResult run;
   try {
     run = simulate(first);
   } catch (const InsideFromHere&) {
+  }
+  if (!std::isnan(stopped)) {
     Settle s = judge(run, theta_o, p, cycle, o, true);
     s.stopped_at = stopped;
+    s.stopped_separation = separations;
     return s;
+  }
+  if (expected > 0 && separations == expected && run.status == SimulationStatus::Completed && run.t_final < o.t_end) {
+    long seen = 0;
+    const Certificate later = [&certificate, &seen, expected](const SimulationEvent& e) {
+      return (e.kind == EventKind::Separation && ++seen <= expected) ? false : certificate(e);
+    };
+    return settled(simulate, p, cycle, o, later);
   }
   if (run.status == SimulationStatus::Rest && run.samples_left_out > 0) {
     theta_o.clear();
@@ -208,7 +230,8 @@ Settle settle_time(const ValidatedEvaluator& evaluator, const LimitCycle& cycle,
   if (!options.stop_on_cycle || !CycleCertificate::applies(cycle)) return settled(simulate, evaluator.parameters(), cycle, options);
   CycleCertificate certificate(evaluator, cycle, moving_band(evaluator.parameters(), cycle, options.fraction * std::fabs(options.step)));
   return settled(simulate, evaluator.parameters(), cycle, options,
-                 [&certificate](const SimulationEvent& e) { return certificate.holds_after(e); });
+                 [&certificate](const SimulationEvent& e) { return certificate.holds_after(e); },
+                 std::max(0L, options.expected_separation));
 }
 
 }  // namespace backlash::numeric

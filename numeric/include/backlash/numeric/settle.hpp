@@ -52,6 +52,10 @@ struct SettleOptions {
   /// every later θo stays inside the band by the check below ("Stopped on the cycle": a check
   /// under a stated assumption, not a proof); false: run it to t_end.
   bool stop_on_cycle = true;
+  /// > 0: the separation (1, 2, …) at which the stop on the cycle is expected — a map's neighbour's
+  /// Settle::stopped_separation (continuation): the simulator ends the run there instead of the
+  /// event sink unwinding it.  A hint only: the answer is the same for any value.
+  long expected_separation = 0;
 };
 
 struct Settle {
@@ -60,6 +64,7 @@ struct Settle {
   double band_low = NAN, band_high = NAN;  ///< the band [rad], absolute (θR included)
   double stopped_at = NAN;  ///< [s] the separation at which the step response was stopped on
                             ///< its cycle; NaN when it ran to t_end or to rest
+  long stopped_separation = 0;  ///< that separation's number (1, 2, …); 0 when not stopped
 };
 
 /// The settle time of `model`'s step response; `cycle` is the point's limit-cycle search
