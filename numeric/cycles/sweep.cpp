@@ -175,10 +175,11 @@ SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& fam
   return row;
 }
 
-// The family: validated at `validation_samples` evenly spaced points (deterministic: before any
-// worker starts); points whose parameters double precision cannot handle are left out.
+// The family: validated at `validation_samples` evenly spaced points on the sweep's threads
+// (deterministic: recorded in order, before any worker starts); points whose parameters double
+// precision cannot handle are left out.
 void validate_family(ValidatedParametricFamily& family, long count, const std::function<SweepPoint(long)>& point,
-                     int validation_samples) {
+                     int validation_samples, int threads) {
   std::vector<Parameters> samples;
   const long k_count = std::min<long>(count, std::max(2, validation_samples));
   for (long k = 0; k < k_count; ++k) {
@@ -187,7 +188,7 @@ void validate_family(ValidatedParametricFamily& family, long count, const std::f
     q.theta_R = 0;
     if (!parameter_scale_problem(q)) samples.push_back(q);
   }
-  family.validate_samples(samples);
+  family.validate_samples(samples, threads);
 }
 
 // The blocks between the workers and the delivering thread: a worker takes the next block while
@@ -252,7 +253,7 @@ class BlockQueue {
 std::shared_ptr<const ValidatedParametricFamily> sweep_family(long count, const std::function<SweepPoint(long)>& point,
                                                               const SweepOptions& options) {
   auto family = std::make_shared<ValidatedParametricFamily>();
-  validate_family(*family, count, point, options.validation_samples);
+  validate_family(*family, count, point, options.validation_samples, options.threads);
   return family;
 }
 
