@@ -146,11 +146,14 @@ void MapPlan::apply(const std::string& v, double x, numeric::Parameters& p, nume
   // The same assignments as `sweep` (api/src/sweep.cpp), so a one-axis map is that sweep.
   const numeric::VariedParameter varied = *numeric::varied_parameter(v);
   numeric::set_varied(varied, x, p, e, base_);
-  std::string text;
-  detail::appendf(text, "%s = %.17g", v.c_str(), x);
+  const auto text = [&v, x] {  // formed only for a refusal: every point of the map passes here
+    std::string out;
+    detail::appendf(out, "%s = %.17g", v.c_str(), x);
+    return out;
+  };
   if (!numeric::physical(p))
-    throw BadInput("vary", text + " gives non-physical parameters (inertias and K > 0, frictions and backlash >= 0)");
-  if (!numeric::admissible(e)) throw BadInput("vary", text + " is outside the effect's range (docs/effects.md)");
+    throw BadInput("vary", text() + " gives non-physical parameters (inertias and K > 0, frictions and backlash >= 0)");
+  if (!numeric::admissible(e)) throw BadInput("vary", text() + " is outside the effect's range (docs/effects.md)");
   if (numeric::contact_laws_clash(e)) throw BadInput("vary", numeric::contact_law_message(v));
   if (const std::string missing = numeric::missing_effect(varied, e); !missing.empty()) throw BadInput("vary", missing);
 }

@@ -1,6 +1,7 @@
 // settle.cpp — the settle time of a step response (settle.hpp; docs/design.md, "Design-space maps").
 #include "backlash/numeric/settle.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -112,7 +113,8 @@ class CycleCertificate {
     if (d > next_try_ || e.after.face != (e.dtheta_o > 0 ? -1 : +1)) return false;
     next_try_ = d / 2;  // a failed try waits for the motion to come twice as close
     // r: |u − v*| and a few ulps more, so that I holds u whatever the rounding of v* ± r.
-    return holds(e.dtheta_o > 0 ? 1.0 : -1.0, d * (1 + 1e-9) + 8 * std::numeric_limits<double>::epsilon() * v);
+    const double sign = e.dtheta_o > 0 ? 1.0 : -1.0, r = d * (1 + 1e-9) + 8 * std::numeric_limits<double>::epsilon() * v;
+    return one_sided_ ? holds_one_sided(sign, u > v ? r : -r) : holds(sign, r);
   }
 
  private:
@@ -124,6 +126,17 @@ class CycleCertificate {
     if (std::fabs(g_low - v) > r || std::fabs(g_high - v) > r) return false;
     if ((g_high - g_low) * cycle_.half_map_derivative < 0) return false;
     return inside(low.extremes) && inside(high.extremes);
+  }
+  // g'(v*) > 0 (settle.hpp): I = [v*, v* + r] or [v* − r, v*] (`signed_r`'s sign: u's side of v*),
+  // whose end v* is the cycle itself (Newton's half cycle: one recombination that holds, then the
+  // separation); only the other end is simulated, and g of it must lie in I.
+  bool holds_one_sided(double sign, double signed_r) const {
+    const double v = cycle_.separation_velocity;
+    const HalfCycle end = half_cycle(evaluator_, sign * (v + signed_r), true);
+    if (!plain(end)) return false;
+    const double moved = sign * end.v_out - v;  // g(end) − v*: toward v* (same sign as signed_r), no farther than r
+    if (moved * signed_r < 0 || std::fabs(moved) > std::fabs(signed_r)) return false;
+    return inside(end.extremes) && inside(Extremes{cycle_.theta_o_min, cycle_.theta_o_max});
   }
   // One recombination that holds, then the separation.
   static bool plain(const HalfCycle& h) {
@@ -140,38 +153,61 @@ class CycleCertificate {
   }
   const ValidatedEvaluator& evaluator_;
   const LimitCycle& cycle_;
+  // Newton's cycle (its half cycle is plain) with g'(v*) > 0: the motion approaches v* from one side.
+  const bool one_sided_ = !cycle_.survey_fallback && cycle_.half_map_derivative > 0;
   const SimulationOptions::SampleBand band_;
   double margin_ = 0;
   double next_try_ = 0;  // |u − v*| at which the next try is made
 };
 
-// Thrown from the run's event sink once every later θo is certified inside the moving band:
-// the run ends there (its samples so far are those of the whole run up to that time).
+// Thrown from the run's event sink once every later θo is certified inside the moving band at a
+// separation other than the expected one: the run ends there (its samples so far are those of the
+// whole run up to that time).
 struct InsideFromHere {};
+
+using Certificate = std::function<bool(const SimulationEvent&)>;
 
 // The settle time from `simulate(options)`: with samples left out by the moving band, again with
 // all of them when that run stopped at rest after leaving some out (its band is θ∞'s).  With a
 // `certificate` (nominal runs toward a stable cycle), the first run stops at the separation from
-// which the rest of the motion is certified inside the band (CycleCertificate).
+// which the rest of the motion is certified inside the band (CycleCertificate): at the
+// `expected` one (SettleOptions::expected_separation) the simulator ends it there
+// (stop_after_separations), at any other the event sink unwinds it.  A run that reached the
+// expected separation uncertified is run again from the start, its certificate skipping the
+// separations it has already judged: the same tries, the same answer.
 template <class Simulate>
 Settle settled(const Simulate& simulate, const Parameters& p, const LimitCycle& cycle, const SettleOptions& o,
-               const std::function<bool(const SimulationEvent&)>& certificate = {}) {
+               const Certificate& certificate = {}, long expected = 0) {
   std::vector<Sample> theta_o;
   SimulationOptions first = sampled(o, theta_o, moving_band(p, cycle, o.fraction * std::fabs(o.step)));
   double stopped = NAN;
-  if (certificate)
-    first.event_sink = [&certificate, &stopped](const SimulationEvent& e) {
+  long separations = 0;
+  if (certificate) {
+    first.stop_after_separations = expected;
+    first.event_sink = [&certificate, &stopped, &separations, expected](const SimulationEvent& e) {
+      separations += e.kind == EventKind::Separation;
       if (!certificate(e)) return;
       stopped = e.t;
-      throw InsideFromHere{};
+      if (separations != expected) throw InsideFromHere{};
     };
+  }
   SimulationResult run;
   try {
     run = simulate(first);
   } catch (const InsideFromHere&) {
+  }
+  if (!std::isnan(stopped)) {
     Settle s = judge(run, theta_o, p, cycle, o, true);
     s.stopped_at = stopped;
+    s.stopped_separation = separations;
     return s;
+  }
+  if (expected > 0 && separations == expected && run.status == SimulationStatus::Completed && run.t_final < o.t_end) {
+    long seen = 0;
+    const Certificate later = [&certificate, &seen, expected](const SimulationEvent& e) {
+      return (e.kind == EventKind::Separation && ++seen <= expected) ? false : certificate(e);
+    };
+    return settled(simulate, p, cycle, o, later);
   }
   if (run.status == SimulationStatus::Rest && run.samples_left_out > 0) {
     theta_o.clear();
@@ -194,7 +230,8 @@ Settle settle_time(const ValidatedEvaluator& evaluator, const LimitCycle& cycle,
   if (!options.stop_on_cycle || !CycleCertificate::applies(cycle)) return settled(simulate, evaluator.parameters(), cycle, options);
   CycleCertificate certificate(evaluator, cycle, moving_band(evaluator.parameters(), cycle, options.fraction * std::fabs(options.step)));
   return settled(simulate, evaluator.parameters(), cycle, options,
-                 [&certificate](const SimulationEvent& e) { return certificate.holds_after(e); });
+                 [&certificate](const SimulationEvent& e) { return certificate.holds_after(e); },
+                 std::max(0L, options.expected_separation));
 }
 
 }  // namespace backlash::numeric

@@ -97,9 +97,11 @@ SweepStatus sweep_status(CycleStatus status) {
 
 namespace {
 
-// The warm start a block carries from point to point (continuation).
+// The warm start a block carries from point to point (continuation): the cycle, and the
+// separation at which the settle run stopped on it (SettleOptions::expected_separation).
 struct Continuation {
   double guess = 0;
+  long settle_separation = 0;
   std::optional<HybridState> warm;
   std::string series;
   bool first = true;
@@ -109,7 +111,7 @@ SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& fam
                    const SettleOptions& settle) {
   SweepRow row;
   row.point = point;
-  if (c.first || point.series != c.series) c.guess = 0, c.warm.reset();
+  if (c.first || point.series != c.series) c.guess = 0, c.warm.reset(), c.settle_separation = 0;
   c.first = false;
   c.series = point.series;
   Parameters q = point.parameters;  // error coordinates: θR = 0
@@ -154,7 +156,12 @@ SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& fam
       lc.guess = c.guess;
       row.cycle = find_limit_cycle(*verdict.evaluator, lc);
       c.guess = row.cycle.status == CycleStatus::LimitCycle ? row.cycle.separation_velocity : 0;
-      if (settle.step != 0) row.settle = settle_time(*verdict.evaluator, row.cycle, settle);
+      if (settle.step != 0) {
+        SettleOptions o = settle;
+        o.expected_separation = c.settle_separation;
+        row.settle = settle_time(*verdict.evaluator, row.cycle, o);
+        c.settle_separation = row.settle.stopped_separation;
+      }
     }
     shift_angles(row.cycle, reference);
     row.settle.band_low += reference, row.settle.band_high += reference;
@@ -168,10 +175,11 @@ SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& fam
   return row;
 }
 
-// The family: validated at `validation_samples` evenly spaced points (deterministic: before any
-// worker starts); points whose parameters double precision cannot handle are left out.
+// The family: validated at `validation_samples` evenly spaced points on the sweep's threads
+// (deterministic: recorded in order, before any worker starts); points whose parameters double
+// precision cannot handle are left out.
 void validate_family(ValidatedParametricFamily& family, long count, const std::function<SweepPoint(long)>& point,
-                     int validation_samples) {
+                     int validation_samples, int threads) {
   std::vector<Parameters> samples;
   const long k_count = std::min<long>(count, std::max(2, validation_samples));
   for (long k = 0; k < k_count; ++k) {
@@ -180,7 +188,7 @@ void validate_family(ValidatedParametricFamily& family, long count, const std::f
     q.theta_R = 0;
     if (!parameter_scale_problem(q)) samples.push_back(q);
   }
-  family.validate_samples(samples);
+  family.validate_samples(samples, threads);
 }
 
 // The blocks between the workers and the delivering thread: a worker takes the next block while
@@ -245,7 +253,7 @@ class BlockQueue {
 std::shared_ptr<const ValidatedParametricFamily> sweep_family(long count, const std::function<SweepPoint(long)>& point,
                                                               const SweepOptions& options) {
   auto family = std::make_shared<ValidatedParametricFamily>();
-  validate_family(*family, count, point, options.validation_samples);
+  validate_family(*family, count, point, options.validation_samples, options.threads);
   return family;
 }
 

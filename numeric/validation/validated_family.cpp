@@ -1,9 +1,15 @@
 #include "backlash/numeric/validated_family.hpp"
 
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <thread>
+
 namespace backlash::numeric {
 
-bool ValidatedParametricFamily::validate_one(const Parameters& p) {
-  const ValidationResult r = validate(parametric_evaluator(p), options_);
+bool ValidatedParametricFamily::validate_one(const Parameters& p) { return record(p, validate(parametric_evaluator(p), options_)); }
+
+bool ValidatedParametricFamily::record(const Parameters& p, const ValidationResult& r) {
   const BranchSelection b = select_branches(p);
   std::lock_guard<std::mutex> lock(mutex_);
   ++validated_;
@@ -18,9 +24,28 @@ bool ValidatedParametricFamily::validate_one(const Parameters& p) {
   return true;
 }
 
-bool ValidatedParametricFamily::validate_samples(const std::vector<Parameters>& samples) {
+bool ValidatedParametricFamily::validate_samples(const std::vector<Parameters>& samples, int threads) {
+  // The gates run in any order; their verdicts are recorded in the samples' order (the first
+  // passing sample's report is its branches').
+  std::vector<std::optional<ValidationResult>> results(samples.size());
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  auto work = [&] {
+    try {
+      for (std::size_t i; (i = next++) < samples.size();) results[i].emplace(validate(parametric_evaluator(samples[i]), options_));
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(failure_mutex);
+      if (!failure) failure = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int k = 1; k < std::min<int>(threads, static_cast<int>(samples.size())); ++k) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
   bool all = true;
-  for (const Parameters& p : samples) all = validate_one(p) && all;
+  for (std::size_t i = 0; i < samples.size(); ++i) all = record(samples[i], *results[i]) && all;
   return all;
 }
 

@@ -24,7 +24,10 @@
 // I = [v* − r, v* + r] around the cycle's v* (r = |u − v*|) that g maps into itself (checked at
 // I's ends: same events, one recombination and a separation, and g(ends) in I, in the order of
 // g'(v*)'s sign) and whose ends' half cycles keep θo (and its mirror image about θR) inside the
-// band by the sample band's margin.  g, and θo's extremes over a half cycle, are ASSUMED monotone
+// band by the sample band's margin.  When g'(v*) > 0 (Newton's cycle: the speeds approach v* from
+// u's side, without alternating) I is the one-sided [v*, u'] (or [u', v*]), u' = v* ± r on u's
+// side: its end v* is the cycle itself (its extremes inside the band by the margin), so one half
+// cycle is simulated, from u', and g(u') must lie in I.  g, and θo's extremes over a half cycle, are ASSUMED monotone
 // on I (they are smooth there, with |g'(v*)| < 1; the checks at I's ends and at v* agree with
 // it, but nothing proves it between them): this stop is a check, not a certificate.  Under that
 // assumption every later sample lies inside the band, so the settle time and the status are
@@ -49,6 +52,10 @@ struct SettleOptions {
   /// every later θo stays inside the band by the check below ("Stopped on the cycle": a check
   /// under a stated assumption, not a proof); false: run it to t_end.
   bool stop_on_cycle = true;
+  /// > 0: the separation (1, 2, …) at which the stop on the cycle is expected — a map's neighbour's
+  /// Settle::stopped_separation (continuation): the simulator ends the run there instead of the
+  /// event sink unwinding it.  A hint only: the answer is the same for any value.
+  long expected_separation = 0;
 };
 
 struct Settle {
@@ -57,6 +64,7 @@ struct Settle {
   double band_low = NAN, band_high = NAN;  ///< the band [rad], absolute (θR included)
   double stopped_at = NAN;  ///< [s] the separation at which the step response was stopped on
                             ///< its cycle; NaN when it ran to t_end or to rest
+  long stopped_separation = 0;  ///< that separation's number (1, 2, …); 0 when not stopped
 };
 
 /// The settle time of `model`'s step response; `cycle` is the point's limit-cycle search

@@ -27,8 +27,9 @@ class ValidatedParametricFamily {
  public:
   explicit ValidatedParametricFamily(ValidationOptions options = {}) : options_(std::move(options)) {}
 
-  /// Validate the parametric evaluator at `samples` (thread-safe).  False if any failed.
-  bool validate_samples(const std::vector<Parameters>& samples);
+  /// Validate the parametric evaluator at `samples` (thread-safe), on up to `threads` threads and
+  /// recorded in the samples' order: the same family for any thread count.  False if any failed.
+  bool validate_samples(const std::vector<Parameters>& samples, int threads = 1);
 
   /// A validated evaluator for `p`, validating `p` itself when its branches are not covered
   /// yet (a pass then covers them for later calls) or a sample of its branch failed; nothing
@@ -50,6 +51,7 @@ class ValidatedParametricFamily {
 
  private:
   bool validate_one(const Parameters& p);
+  bool record(const Parameters& p, const ValidationResult& r);  // a sample's verdict, counted
   ValidationOptions options_;
   mutable std::mutex mutex_;
   std::map<Branch, ValidationReport> passed_;
