@@ -437,16 +437,17 @@ std::optional<Trial> best_pair(Search& s, const std::vector<Trial>& singles, dou
   if (effect != fitted.end()) std::rotate(fitted.begin() + static_cast<std::ptrdiff_t>(bases), effect, effect + 1), ++bases;
   std::vector<Screened> screened;
   screen_partners(s, fitted, 0, bases, screened);
-  // The best single's best-screened partner, an effect below the bases, is a base too: a pair found
-  // beside a stand-in (a delay beside K where Coulomb friction on the motor is missing, ΔBIC −6699:
-  // the delay alone, +377, ranked twelfth and the friction, −3.5, eighth) is found from its side.
+  // The best single's best-screened partner, when it is an effect below the bases, is a base too: a
+  // pair found beside a stand-in (a delay beside K where Coulomb friction on the motor is missing,
+  // ΔBIC −6699: the delay alone, +377, ranked twelfth and the friction, −3.5, eighth) is found from
+  // the partner's side.
   const Screened* partner = nullptr;
   for (const Screened& x : screened)
-    if (x.single == fitted[0] && std::isfinite(x.sse) && !is_parameter_correction(x.partner->result.effect) &&
-        std::find(fitted.begin(), fitted.begin() + static_cast<std::ptrdiff_t>(bases), x.partner) ==
-            fitted.begin() + static_cast<std::ptrdiff_t>(bases) &&
-        (!partner || x.sse < partner->sse))
-      partner = &x;
+    if (x.single == fitted[0] && std::isfinite(x.sse) && (!partner || x.sse < partner->sse)) partner = &x;
+  if (partner && (is_parameter_correction(partner->partner->result.effect) ||
+                  std::find(fitted.begin(), fitted.begin() + static_cast<std::ptrdiff_t>(bases), partner->partner) !=
+                      fitted.begin() + static_cast<std::ptrdiff_t>(bases)))
+    partner = nullptr;
   if (partner) {
     const auto at = std::find(fitted.begin(), fitted.end(), partner->partner);
     std::rotate(fitted.begin() + static_cast<std::ptrdiff_t>(bases), at, at + 1);
