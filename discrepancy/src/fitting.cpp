@@ -377,9 +377,10 @@ void prepare_candidate(Simulator& simulator, const EffectCandidate& c, const Mod
 // model's first departure from the record (where the response still depends smoothly on the
 // parameter — over a long record a lively gear's response, say with a high restitution, is
 // nearly chaotic in it), then refined from there on horizons growing by half, the bracket
-// narrowing as the valley of the cost does.  Given a start (a refit), only the last stage runs.
+// narrowing as the valley of the cost does.  Given a start (a refit), only the last stage runs —
+// or, with `grow_from_start`, every stage from that start (a pair refined: docs/discrepancy.md).
 Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoint& base, const EffectCandidate& c,
-                  bool whole_record, const std::vector<double>* start_u, long budget, double departure) {
+                  bool whole_record, const std::vector<double>* start_u, long budget, double departure, bool grow_from_start) {
   Fit fit;
   std::atomic<int> calls{0};
   std::atomic<long> work{0}, weighted{0};
@@ -405,21 +406,23 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
   const double t0 = data.t.front(), t_end = data.t.back();
   std::vector<double> horizons{t_end};
   std::vector<std::vector<double>> starts;
-  if (start_u) {
-    starts.push_back(*start_u);
-  } else {
+  if (!start_u || grow_from_start) {
     const double first = std::isfinite(departure) ? departure : t0;
     double h = std::min(t_end, std::max(first + 0.25 * numeric::servo_period(base.p), t0 + 0.05 * (t_end - t0)));
     horizons.clear();
     for (; h < t_end; h = t0 + 1.5 * (h - t0)) horizons.push_back(h);
     horizons.push_back(t_end);
+  }
+  if (start_u) {
+    starts.push_back(*start_u);
+  } else {
     const std::vector<std::size_t> first_samples = prefix(data, samples, horizons.front());
     starts = scan_starts(Objective{simulator, data, base, c, first_samples, calls, work, weighted, budget, loss_scale}, c);
   }
   // One parameter: the best two distinct valleys are followed from stage to stage (a valley
   // that looks best on a short horizon can lose on a longer one).
   Solved best;
-  double cell = start_u ? 0.02 : 1.0 / 39;  // one parameter: Brent's bracket, narrowing as the horizon grows
+  double cell = start_u && !grow_from_start ? 0.02 : 1.0 / 39;  // one parameter: Brent's bracket, narrowing as the horizon grows
   for (std::size_t stage = 0; stage < horizons.size(); ++stage, cell = std::max(0.004, 0.6 * cell)) {
     const std::vector<std::size_t> stage_samples = prefix(data, samples, horizons[stage]);
     const Objective objective{simulator, data, base, c, stage_samples, calls, work, weighted, budget, loss_scale};

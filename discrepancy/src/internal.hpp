@@ -155,10 +155,11 @@ void prepare_candidate(Simulator& simulator, const EffectCandidate& c, const Mod
 /// (its best point kept; Fit::budget_exhausted says so) — a count, so the result does not depend
 /// on the machine's speed or load.
 /// `departure`: where the base model first leaves the record's noise band — the first stage of
-/// the growing horizon ends a quarter servo period after it.
+/// the growing horizon ends a quarter servo period after it.  Given `start_u`, only the last stage
+/// (the whole horizon) runs, from it — unless `grow_from_start`: then every stage, from it (no scan).
 Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoint& base, const EffectCandidate& c,
                   bool whole_record, const std::vector<double>* start_u = nullptr, long budget = std::numeric_limits<long>::max(),
-                  double departure = NAN);
+                  double departure = NAN, bool grow_from_start = false);
 
 }  // namespace backlash::discrepancy::detail
 
