@@ -67,27 +67,37 @@ constexpr std::size_t kSingles = 5;
 /// that only a joint fit shows — its single fit biased by the missing partner — can rank low there).
 constexpr std::size_t kPartners = 8;
 
-// A named candidate's parameters as reported (the compliance's damping from its ratio).
+// A named candidate's parameters as reported: one fitted relative to another (the compliance's
+// damping from its ratio, Stribeck's static level from its ratio to the kinetic one,
+// model::CandidateScale) as the model's value; σ of Ts from σ of both (taken as independent).
 std::vector<Parameter> reported(const EffectCandidate& c, const std::vector<double>& values,
                                 const std::vector<double>& uncertainty, const ModelPoint& point) {
   std::vector<Parameter> out;
   for (std::size_t i = 0; i < c.ranges.size(); ++i)
     out.push_back({c.ranges[i].name, values[i], uncertainty.empty() ? NAN : uncertainty[i]});
-  if (c.effect == "compliance") {
-    const double ratio = values[1], ratio_sigma = out[1].uncertainty;
-    const double scale = point.e.mesh_damping / ratio;
-    out[1] = {"damping", point.e.mesh_damping, ratio_sigma * scale};
+  const model::EffectInfo* row = model::effect_keyed(c.effect);
+  for (std::size_t k = 0; row && k < row->count && k < out.size(); ++k) {
+    const model::EffectParameterInfo& parameter = model::effect_parameters[row->first + k];
+    const double value = model::field(point.e, parameter.id), ratio = values[k];
+    if (parameter.scale == model::CandidateScale::DampingRatio) out[k] = {out[k].name, value, out[k].uncertainty * value / ratio};
+    if (parameter.scale == model::CandidateScale::KineticRatio) {
+      const double kinetic = value / ratio, kinetic_sigma = out[k + 1].uncertainty;  // the kinetic level follows
+      out[k] = {out[k].name, value, value * std::hypot(out[k].uncertainty / ratio, kinetic_sigma / kinetic)};
+    }
   }
   return out;
 }
 
 // The fit's coordinate u of a named candidate's reported parameter (the compliance's damping
-// back to its ratio).
+// back to its ratio, Stribeck's static level back to Ts/Tk).
 double coordinate_of(const EffectCandidate& c, const std::vector<Parameter>& ps, std::size_t j, const ModelPoint& base) {
   const ParameterRange& r = c.ranges[j];
   double value = ps[j].value;
   if (c.effect == "compliance" && j == 1)
     value = value / (2 * std::sqrt(ps[0].value * base.p.Jm * base.p.JL / (base.p.Jm + base.p.JL)));
+  if (const model::EffectInfo* row = model::effect_keyed(c.effect); row && j + 1 < ps.size() &&
+      model::effect_parameters[row->first + j].scale == model::CandidateScale::KineticRatio)
+    value = value / ps[j + 1].value;
   const double u = r.logarithmic ? std::log(value / r.low) / std::log(r.high / r.low) : (value - r.low) / (r.high - r.low);
   return std::min(1.0, std::max(0.0, u));
 }
@@ -334,6 +344,14 @@ std::string combination_problem(const std::string& a, const std::string& b) {
   const model::EffectInfo* y = model::effect_keyed(b);
   if (x && y && x->contact_law && y->contact_law)
     return a + " and " + b + " cannot be combined: both are contact laws (one law at the contact)";
+  // Stribeck friction (docs/effects.md): its kinetic level adds to the same body's Coulomb torque
+  // (only the sum could be fitted), and the delayed model has none.
+  const bool stribeck_a = a.rfind("stribeck_", 0) == 0, stribeck_b = b.rfind("stribeck_", 0) == 0;
+  if ((stribeck_a || stribeck_b) && (a == "delay" || b == "delay"))
+    return a + " and " + b + " cannot be combined: the delayed model has no Stribeck friction";
+  if (stribeck_a != stribeck_b && shaft_of(a) == shaft_of(b) && shaft_of(a) != 0 && torque_level(a) && torque_level(b) &&
+      (a.rfind("coulomb_", 0) == 0 || b.rfind("coulomb_", 0) == 0))
+    return a + " and " + b + " cannot be combined: both are the friction level of one body";
   return "";
 }
 

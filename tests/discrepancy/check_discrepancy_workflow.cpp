@@ -99,6 +99,13 @@ Hidden hide(const std::string& effect, const Parameters& p, double step, double 
   if (effect == "delay") h.truth = h.effects.delay = 0.01 * strength * period;
   if (effect == "backlash_size") h.truth = h.parameters.backlash = (1 + 0.5 * strength) * p.backlash;
   if (effect == "torque_offset") h.truth = h.effects.torque_offset = 0.03 * strength * torque;
+  if (effect == "stribeck_motor" || effect == "stribeck_load") {  // Ts = 2·Tk, vs 0.3 of the step over the period
+    const bool motor = effect == "stribeck_motor";
+    const double velocity = 0.3 * std::fabs(step) / period;
+    (motor ? h.effects.stribeck_motor_kinetic : h.effects.stribeck_load_kinetic) = 0.03 * strength * torque;
+    h.truth = (motor ? h.effects.stribeck_motor_static : h.effects.stribeck_load_static) = 0.06 * strength * torque;
+    (motor ? h.effects.stribeck_motor_velocity : h.effects.stribeck_load_velocity) = velocity;
+  }
   return h;
 }
 
