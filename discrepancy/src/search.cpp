@@ -281,12 +281,27 @@ std::vector<Trial> round_of(Search& s, double departure, const std::vector<std::
   }
   std::mutex progress_mutex;
   long finished = 0;
-  parallel_for(trials.size(), s.options.threads, [&](std::size_t i) {
-    if (fitted[i]) run_trial(trials[i], s, names[i], departure, nullptr);
-    if (!s.options.progress) return;
-    std::lock_guard<std::mutex> lock(progress_mutex);
-    s.options.progress(++finished, static_cast<long>(trials.size()));
-  });
+  // Stribeck friction (three parameters, integrated) is fitted after the rest, and only where the
+  // same body's Coulomb friction was decisive in this round (docs/discrepancy.md): its cheap screen.
+  auto screened_by_coulomb = [&](std::size_t i) { return names[i].rfind("stribeck_", 0) == 0; };
+  for (int pass = 0; pass < 2; ++pass)
+    parallel_for(trials.size(), s.options.threads, [&](std::size_t i) {
+      if (screened_by_coulomb(i) != (pass == 1)) return;
+      if (fitted[i] && pass == 1) {
+        const std::string coulomb = "coulomb_" + names[i].substr(std::string("stribeck_").size());
+        const auto j = std::find(names.begin(), names.end(), coulomb) - names.begin();
+        if (j == static_cast<std::ptrdiff_t>(names.size()) || !trials[static_cast<std::size_t>(j)].result.decisive) {
+          fitted[i] = 0;
+          trials[i].result.effect = names[i];
+          trials[i].result.failure = "not fitted: " + coulomb + " was not decisive in this round";
+          trials[i].result.bic = trials[i].result.rms = trials[i].result.rms_holdout = INFINITY;
+        }
+      }
+      if (fitted[i]) run_trial(trials[i], s, names[i], departure, nullptr);
+      if (!s.options.progress) return;
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      s.options.progress(++finished, static_cast<long>(trials.size()));
+    });
   std::stable_sort(trials.begin(), trials.end(), [](const Trial& a, const Trial& b) { return a.result.bic < b.result.bic; });
   return trials;
 }
