@@ -261,6 +261,7 @@ struct Solved {
   std::vector<double> u;
   double sse = INFINITY;
   std::vector<double> covariance;  ///< of u (k × k), scaled by the residual variance
+  std::string no_covariance;       ///< why `covariance` is empty when it was asked for
 };
 
 Solved solve(const Objective& objective, std::vector<double> u, bool with_covariance, int iterations) {
@@ -295,6 +296,9 @@ Solved solve(const Objective& objective, std::vector<double> u, bool with_covari
   const bool evaluated = with_covariance && n > k &&
                          problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost_value, nullptr, nullptr, &jacobian) &&
                          std::all_of(jacobian.values.begin(), jacobian.values.end(), [](double v) { return std::isfinite(v); });
+  if (with_covariance && !evaluated)
+    out.no_covariance = n <= k ? "fewer samples than parameters"
+                               : "the Jacobian at the optimum could not be evaluated (a simulation near it failed)";
   if (evaluated) {
     ceres::Covariance::Options covariance_options;
     covariance_options.algorithm_type = ceres::DENSE_SVD;
@@ -306,6 +310,8 @@ Solved solve(const Objective& objective, std::vector<double> u, bool with_covari
       covariance.GetCovarianceBlock(u.data(), u.data(), out.covariance.data());
       const double variance = out.sse / (n - k);
       for (double& c : out.covariance) c *= variance;
+    } else {
+      out.no_covariance = "the covariance is singular: the record does not determine the parameters separately";
     }
   }
   return out;
@@ -343,7 +349,7 @@ Solved brent(const Objective& objective, double start, double cell) {
   std::uintmax_t iterations = 60;
   const auto [x, value] = boost::math::tools::brent_find_minima(sse, std::max(0.0, best_x - spacing),
                                                                 std::min(1.0, best_x + spacing), 40, iterations);
-  return value < best_value ? Solved{{x}, value, {}} : Solved{{best_x}, best_value, {}};
+  return value < best_value ? Solved{{x}, value, {}, {}} : Solved{{best_x}, best_value, {}, {}};
 }
 
 // The best distinct points of the candidate's scan on these samples.
@@ -446,17 +452,23 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
     starts = {best.u};
     for (const Solved& s : found)
       if (k == 1 && starts.size() < 2 && std::fabs(s.u[0] - best.u[0]) > cell) starts.push_back(s.u);
-    if (stage + 1 == horizons.size() && whole_record) best.covariance = solve(objective, best.u, true, 0).covariance;
+    if (stage + 1 == horizons.size() && whole_record) {
+      Solved at = solve(objective, best.u, true, 0);
+      best.covariance = std::move(at.covariance), best.no_covariance = std::move(at.no_covariance);
+    }
   }
   fit.simulations = calls.load();
   fit.budget_exhausted = work.load() >= budget || weighted.load() / 4 >= budget || simulator.budget_reached();
   fit.ok = true;
   fit.u = best.u;
   fit.sse_fit = best.sse;
+  fit.no_sigma = whole_record ? best.no_covariance : "fitted on the first part only (no covariance)";
   for (std::size_t i = 0; i < k; ++i) {
     fit.values.push_back(c.ranges[i].value(best.u[i]));
     const double var = best.covariance.empty() ? NAN : best.covariance[i * k + i];
     fit.uncertainty.push_back(std::fabs(c.ranges[i].derivative(best.u[i])) * std::sqrt(var));
+    if (!std::isfinite(fit.uncertainty.back()) && fit.no_sigma.empty())
+      fit.no_sigma = "the covariance's variance of " + c.ranges[i].name + " is not a finite positive number";
   }
   return fit;
 }

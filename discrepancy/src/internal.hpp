@@ -139,7 +139,8 @@ struct Fit {
   bool ok = false;
   std::vector<double> u;       ///< in [0, 1]
   std::vector<double> values;  ///< physical
-  std::vector<double> uncertainty;
+  std::vector<double> uncertainty;  ///< NaN where no covariance (then no_sigma says why)
+  std::string no_sigma;             ///< why `uncertainty` is NaN (empty when it is not)
   double sse_fit = 0;          ///< weighted, on the fitted samples
   int simulations = 0;
   bool budget_exhausted = false;  ///< the fit stopped at its work budget (its best point is kept)
