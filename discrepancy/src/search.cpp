@@ -694,12 +694,19 @@ bool refine_friction(Search& s, std::vector<std::string>& refinements, std::vect
     y.candidate = candidate_for(name, s.base, s.step);
     y.result = Candidate{};
     y.result.effect = name;
-    y.result.parameters = refinement_start(s, i, y.candidate);
-    const auto point = y.result.parameters.empty() ? std::nullopt : joint_refit(s, refined);
-    const auto traces = point ? s.simulator.traces(*point, s.o.size()) : std::nullopt;
     Candidate& r = refined[i].result;
+    std::optional<ModelPoint> point;
+    std::optional<std::vector<std::vector<double>>> traces;
+    if (s.current.e.delay > 0) r.failure = "refining " + coulomb + ": the delayed model has no Stribeck friction";
+    else try {
+        r.parameters = refinement_start(s, i, y.candidate);
+        if (!r.parameters.empty()) point = joint_refit(s, refined);
+        if (point) traces = s.simulator.traces(*point, s.o.size());
+      } catch (const std::exception& error) {  // a model that cannot be simulated: not refined
+        r.failure = "refining " + coulomb + ": " + error.what();
+      }
     if (!traces) {
-      r.failure = "refining " + coulomb + ": its refit with everything named failed";
+      if (r.failure.empty()) r.failure = "refining " + coulomb + ": its refit with everything named failed";
       r.bic = r.rms = r.rms_holdout = INFINITY;
       round.push_back(r);
       continue;
