@@ -27,10 +27,18 @@ std::vector<std::vector<double>> EffectCandidate::scan() const {
   if (ranges.size() == 1) {
     constexpr int n = 40;  // fine: with many bounces or events the cost has many shallow valleys
     for (int i = 0; i < n; ++i) points.push_back({i / double(n - 1)});
-  } else {
+  } else if (ranges.size() == 2) {
     constexpr int n0 = 7, n1 = 5;
     for (int i = 0; i < n0; ++i)
       for (int j = 0; j < n1; ++j) points.push_back({i / double(n0 - 1), j / double(n1 - 1)});
+  } else {
+    // Three (Stribeck friction: Ts/Tk, Tk, vs): cell centres, the middle parameter (the kinetic
+    // level, where a Coulomb friction's scan would bracket) the finest; Ts/Tk = 1 (at the range's
+    // end, Coulomb friction) is not a start.
+    constexpr int n0 = 3, n1 = 8, n2 = 3;
+    for (int j = 0; j < n1; ++j)
+      for (int i = 0; i < n0; ++i)
+        for (int l = 0; l < n2; ++l) points.push_back({(i + 0.5) / n0, (j + 0.5) / n1, (l + 0.5) / n2});
   }
   return points;
 }
@@ -48,14 +56,26 @@ double scale_of(model::CandidateScale scale, const numeric::Parameters& p, doubl
     case model::CandidateScale::ServoPeriod: return numeric::servo_period(p);
     case model::CandidateScale::StepVelocity: return std::fabs(step) / numeric::servo_period(p);
     case model::CandidateScale::Absolute:
-    case model::CandidateScale::DampingRatio: return 1;
+    case model::CandidateScale::DampingRatio:
+    case model::CandidateScale::KineticRatio: return 1;
   }
   return 1;
 }
 
+/// A parameter fitted relative to another of its effect (model::CandidateScale): the compliance's
+/// damping from its ratio ζ = cc/(2√(kc·m)), m the reduced inertia, with kc the stiffness fitted
+/// with it (the parameter before); Stribeck's static level from its ratio Ts/Tk ≥ 1 to the kinetic
+/// level fitted with it (the parameter after) — so Ts ≥ Tk at every point a fit tries.
+double relative_value(const model::EffectInfo& effect, std::size_t k, const std::vector<double>& v, double reduced_inertia) {
+  const model::EffectParameterInfo& parameter = model::effect_parameters[effect.first + k];
+  if (parameter.scale == model::CandidateScale::DampingRatio) return 2 * v[k] * std::sqrt(v[k - 1] * reduced_inertia);
+  if (parameter.scale == model::CandidateScale::KineticRatio) return v[k] * v[k + 1];
+  return v[k];
+}
+
 /// The candidate of an effect of the table: its parameters' ranges, scaled; applying it sets
-/// them (a damping from its ratio ζ = cc/(2√(kc·m)), m the reduced inertia) and, for a
-/// contact law, puts every other contact law back to its neutral values.
+/// them (relative_value) and, for a contact law, puts every other contact law back to its
+/// neutral values.
 EffectCandidate table_candidate(const model::EffectInfo& effect, const numeric::Parameters& p, double step) {
   EffectCandidate c;
   c.effect = std::string(effect.key);
@@ -67,12 +87,8 @@ EffectCandidate table_candidate(const model::EffectInfo& effect, const numeric::
   const double reduced_inertia = p.Jm * p.JL / (p.Jm + p.JL);
   c.apply = [&effect, reduced_inertia](const ModelPoint& b, const std::vector<double>& v) {
     ModelPoint m = b;
-    for (std::size_t k = 0; k < effect.count; ++k) {
-      const model::EffectParameterInfo& parameter = model::effect_parameters[effect.first + k];
-      model::field(m.e, parameter.id) = parameter.scale == model::CandidateScale::DampingRatio
-                                            ? 2 * v[k] * std::sqrt(v[k - 1] * reduced_inertia)
-                                            : v[k];
-    }
+    for (std::size_t k = 0; k < effect.count; ++k)
+      model::field(m.e, model::effect_parameters[effect.first + k].id) = relative_value(effect, k, v, reduced_inertia);
     if (effect.contact_law)
       for (const model::EffectInfo& other : model::effects_table)
         if (&other != &effect && other.contact_law)

@@ -144,13 +144,20 @@ long Simulator::cost(const ModelPoint& m, std::size_t events) const {
   // oscillation over the record (a delayed case V over 30 s: about 12 closed-form simulations,
   // 400 per radian) and a compliant mesh's, whose stiff oscillation then dominates (1300 per
   // radian of the mesh: 0.1 s for a mesh of ω ≈ 26/s over 30 s), as with a saturating drive
-  // (50 per radian).  A compliant mesh alone is in closed form.
+  // (50 per radian).  A compliant mesh alone is in closed form.  Stribeck friction is integrated
+  // (dopri5) wherever a body slips slower than √50·vs: 1000·(vs/v)^1.5 per radian of the servo's
+  // oscillation, v the step over the servo period (case V's 30 s record: vs = 0.06·v costs 1.5
+  // closed-form simulations, 0.2·v 3, 0.6·v 15).
   const double span = t_end_ - step_time_;
   const double servo = span * 2 * M_PI / numeric::servo_period(m.p);
   const double mesh = m.e.compliant() ? span * std::sqrt(m.e.mesh_stiffness * (m.p.Jm + m.p.JL) / (m.p.Jm * m.p.JL)) : 0.0;
   double work = 1000 + static_cast<double>(events);
   if (m.e.delay > 0) work += 400 * servo + 1300 * mesh;
   else if (m.e.saturating()) work += 50 * mesh;
+  const double v = std::fabs(step_) / numeric::servo_period(m.p);
+  for (const auto& [level, vs] : {std::pair{m.e.stribeck_motor_static, m.e.stribeck_motor_velocity},
+                                  std::pair{m.e.stribeck_load_static, m.e.stribeck_load_velocity}})
+    if (level > 0 && std::isfinite(vs)) work += 1000 * std::pow(vs / v, 1.5) * servo;
   return static_cast<long>(std::min(work, 1e15));
 }
 
@@ -254,6 +261,7 @@ struct Solved {
   std::vector<double> u;
   double sse = INFINITY;
   std::vector<double> covariance;  ///< of u (k × k), scaled by the residual variance
+  std::string no_covariance;       ///< why `covariance` is empty when it was asked for
 };
 
 Solved solve(const Objective& objective, std::vector<double> u, bool with_covariance, int iterations) {
@@ -288,6 +296,9 @@ Solved solve(const Objective& objective, std::vector<double> u, bool with_covari
   const bool evaluated = with_covariance && n > k &&
                          problem.Evaluate(ceres::Problem::EvaluateOptions(), &cost_value, nullptr, nullptr, &jacobian) &&
                          std::all_of(jacobian.values.begin(), jacobian.values.end(), [](double v) { return std::isfinite(v); });
+  if (with_covariance && !evaluated)
+    out.no_covariance = n <= k ? "fewer samples than parameters"
+                               : "the Jacobian at the optimum could not be evaluated (a simulation near it failed)";
   if (evaluated) {
     ceres::Covariance::Options covariance_options;
     covariance_options.algorithm_type = ceres::DENSE_SVD;
@@ -299,6 +310,8 @@ Solved solve(const Objective& objective, std::vector<double> u, bool with_covari
       covariance.GetCovarianceBlock(u.data(), u.data(), out.covariance.data());
       const double variance = out.sse / (n - k);
       for (double& c : out.covariance) c *= variance;
+    } else {
+      out.no_covariance = "the covariance is singular: the record does not determine the parameters separately";
     }
   }
   return out;
@@ -336,7 +349,7 @@ Solved brent(const Objective& objective, double start, double cell) {
   std::uintmax_t iterations = 60;
   const auto [x, value] = boost::math::tools::brent_find_minima(sse, std::max(0.0, best_x - spacing),
                                                                 std::min(1.0, best_x + spacing), 40, iterations);
-  return value < best_value ? Solved{{x}, value, {}} : Solved{{best_x}, best_value, {}};
+  return value < best_value ? Solved{{x}, value, {}, {}} : Solved{{best_x}, best_value, {}, {}};
 }
 
 // The best distinct points of the candidate's scan on these samples.
@@ -442,17 +455,23 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
     starts = {best.u};
     for (const Solved& s : found)
       if (k == 1 && starts.size() < 2 && std::fabs(s.u[0] - best.u[0]) > cell) starts.push_back(s.u);
-    if (stage + 1 == horizons.size() && whole_record) best.covariance = solve(objective, best.u, true, 0).covariance;
+    if (stage + 1 == horizons.size() && whole_record) {
+      Solved at = solve(objective, best.u, true, 0);
+      best.covariance = std::move(at.covariance), best.no_covariance = std::move(at.no_covariance);
+    }
   }
   fit.simulations = calls.load();
   fit.budget_exhausted = work.load() >= budget || weighted.load() / 4 >= budget || simulator.budget_reached();
   fit.ok = true;
   fit.u = best.u;
   fit.sse_fit = best.sse;
+  fit.no_sigma = whole_record ? best.no_covariance : "fitted on the first part only (no covariance)";
   for (std::size_t i = 0; i < k; ++i) {
     fit.values.push_back(c.ranges[i].value(best.u[i]));
     const double var = best.covariance.empty() ? NAN : best.covariance[i * k + i];
     fit.uncertainty.push_back(std::fabs(c.ranges[i].derivative(best.u[i])) * std::sqrt(var));
+    if (!std::isfinite(fit.uncertainty.back()) && fit.no_sigma.empty())
+      fit.no_sigma = "the covariance's variance of " + c.ranges[i].name + " is not a finite positive number";
   }
   return fit;
 }

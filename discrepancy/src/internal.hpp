@@ -87,7 +87,8 @@ class Simulator {
   void prepare(const std::vector<ModelPoint>& points);
   int simulations() const { return simulations_.load(); }
   /// A simulation's work: 1000 plus its events; a delayed model's more (numerical integration:
-  /// 400 per radian of the servo's oscillation over the record, 40 per radian of a mesh's).
+  /// 400 per radian of the servo's oscillation over the record, 40 per radian of a mesh's; Stribeck
+  /// friction 1000·(vs/v)^1.5 per radian of the servo's, v = |step|/servo period).
   long cost(const ModelPoint& m, std::size_t events) const;
   /// The work of every simulation so far (cost()).
   long work() const { return work_.load(); }
@@ -138,7 +139,8 @@ struct Fit {
   bool ok = false;
   std::vector<double> u;       ///< in [0, 1]
   std::vector<double> values;  ///< physical
-  std::vector<double> uncertainty;
+  std::vector<double> uncertainty;  ///< NaN where no covariance (then no_sigma says why)
+  std::string no_sigma;             ///< why `uncertainty` is NaN (empty when it is not)
   double sse_fit = 0;          ///< weighted, on the fitted samples
   int simulations = 0;
   bool budget_exhausted = false;  ///< the fit stopped at its work budget (its best point is kept)

@@ -12,6 +12,7 @@
 #include <atomic>
 #include <chrono>
 #include <deque>
+#include <iterator>
 #include <cmath>
 #include <mutex>
 #include <map>
@@ -67,27 +68,37 @@ constexpr std::size_t kSingles = 5;
 /// that only a joint fit shows — its single fit biased by the missing partner — can rank low there).
 constexpr std::size_t kPartners = 8;
 
-// A named candidate's parameters as reported (the compliance's damping from its ratio).
+// A named candidate's parameters as reported: one fitted relative to another (the compliance's
+// damping from its ratio, Stribeck's static level from its ratio to the kinetic one,
+// model::CandidateScale) as the model's value; σ of Ts from σ of both (taken as independent).
 std::vector<Parameter> reported(const EffectCandidate& c, const std::vector<double>& values,
                                 const std::vector<double>& uncertainty, const ModelPoint& point) {
   std::vector<Parameter> out;
   for (std::size_t i = 0; i < c.ranges.size(); ++i)
     out.push_back({c.ranges[i].name, values[i], uncertainty.empty() ? NAN : uncertainty[i]});
-  if (c.effect == "compliance") {
-    const double ratio = values[1], ratio_sigma = out[1].uncertainty;
-    const double scale = point.e.mesh_damping / ratio;
-    out[1] = {"damping", point.e.mesh_damping, ratio_sigma * scale};
+  const model::EffectInfo* row = model::effect_keyed(c.effect);
+  for (std::size_t k = 0; row && k < row->count && k < out.size(); ++k) {
+    const model::EffectParameterInfo& parameter = model::effect_parameters[row->first + k];
+    const double value = model::field(point.e, parameter.id), ratio = values[k];
+    if (parameter.scale == model::CandidateScale::DampingRatio) out[k] = {out[k].name, value, out[k].uncertainty * value / ratio};
+    if (parameter.scale == model::CandidateScale::KineticRatio) {
+      const double kinetic = value / ratio, kinetic_sigma = out[k + 1].uncertainty;  // the kinetic level follows
+      out[k] = {out[k].name, value, value * std::hypot(out[k].uncertainty / ratio, kinetic_sigma / kinetic)};
+    }
   }
   return out;
 }
 
 // The fit's coordinate u of a named candidate's reported parameter (the compliance's damping
-// back to its ratio).
+// back to its ratio, Stribeck's static level back to Ts/Tk).
 double coordinate_of(const EffectCandidate& c, const std::vector<Parameter>& ps, std::size_t j, const ModelPoint& base) {
   const ParameterRange& r = c.ranges[j];
   double value = ps[j].value;
   if (c.effect == "compliance" && j == 1)
     value = value / (2 * std::sqrt(ps[0].value * base.p.Jm * base.p.JL / (base.p.Jm + base.p.JL)));
+  if (const model::EffectInfo* row = model::effect_keyed(c.effect); row && j + 1 < ps.size() &&
+      model::effect_parameters[row->first + j].scale == model::CandidateScale::KineticRatio)
+    value = value / ps[j + 1].value;
   const double u = r.logarithmic ? std::log(value / r.low) / std::log(r.high / r.low) : (value - r.low) / (r.high - r.low);
   return std::min(1.0, std::max(0.0, u));
 }
@@ -98,6 +109,19 @@ struct Trial {
   Candidate result;
   ModelPoint point;
 };
+
+// The held-out samples confirm a model scored `sc` against the current one: they must shrink, or,
+// when the model already meets them at the noise level, at least not get worse.  Shrinking means
+// to at most decisive_holdout of the current RMS, or by as much as the held-out samples' own
+// likelihood ratio calls decisive (n_eff·ln(SSE ratio) < −decisive_bic: a large gap that a real
+// effect closes only in part, while another remains).
+bool holdout_confirms(const Search& s, const Scores& sc) {
+  const DiscrepancyOptions& options = s.options;
+  const double held = s.scores.rms_holdout(), rms = sc.rms_holdout();
+  const double n_held = std::max(1.0, static_cast<double>(sc.n_holdout) / s.o.tau_int);
+  return rms < options.decisive_holdout * held || n_held * 2 * std::log(rms / held) < -options.decisive_bic ||
+         (held <= options.noise_level && rms <= 1.02 * held);
+}
 
 // A fitted trial scored against the current model by the decisive rule (docs/discrepancy.md).
 void judge(Trial& t, const Search& s, int current_k) {
@@ -117,16 +141,8 @@ void judge(Trial& t, const Search& s, int current_k) {
   const int k = current_k + static_cast<int>(t.candidate.ranges.size());
   t.result.bic = sc.bic(k);
   t.result.delta_bic = t.result.bic - s.scores.bic(current_k);
-  // Decisive on both: the BIC, and the held-out samples — they must shrink, or, when the model
-  // already meets them at the noise level, at least not get worse.
-  // Shrinking means to at most decisive_holdout of the current RMS, or by as much as the held-out
-  // samples' own likelihood ratio calls decisive (n_eff·ln(SSE ratio) < −decisive_bic: a large
-  // gap that a real effect closes only in part, while another remains).
-  const double held = s.scores.rms_holdout();
-  const double n_held = std::max(1.0, static_cast<double>(sc.n_holdout) / s.o.tau_int);
-  const bool confirmed = t.result.rms_holdout < options.decisive_holdout * held ||
-                         n_held * 2 * std::log(t.result.rms_holdout / held) < -options.decisive_bic ||
-                         (held <= options.noise_level && t.result.rms_holdout <= 1.02 * held);
+  // Decisive on both: the BIC, and the held-out samples (holdout_confirms).
+  const bool confirmed = holdout_confirms(s, sc);
   // A parameter pinned at the edge of its range cannot be told from that limit: not decisive.
   t.result.at_range_edge = std::any_of(t.fit.u.begin(), t.fit.u.end(), [](double u) { return u < 1e-3 || u > 1 - 1e-3; });
   t.result.decisive = t.result.delta_bic < -options.decisive_bic && confirmed && !t.result.at_range_edge;
@@ -521,6 +537,7 @@ std::optional<ModelPoint> joint_refit(Search& s, std::vector<Named>& named) {
     const std::vector<double> values(fit.values.begin() + at, fit.values.begin() + at + k);
     const std::vector<double> sigma(fit.uncertainty.begin() + at, fit.uncertainty.begin() + at + k);
     n.result.parameters = reported(n.candidate, values, sigma, point);
+    n.result.no_sigma = std::all_of(sigma.begin(), sigma.end(), [](double x) { return std::isfinite(x); }) ? "" : fit.no_sigma;
     n.result.simulations += fit.simulations;
     at += k;
   }
@@ -558,9 +575,11 @@ void name_trial(Search& s, const Trial& t) {
   const Fit whole = fit_candidate(s.simulator, s.o, s.current, t.candidate, true, &t.fit.u);
   Named n{t.result, t.candidate};
   ModelPoint point = t.point;
+  n.result.no_sigma = "its fit on the whole record failed (the fit on the first part has no covariance)";
   if (whole.ok) {
     point = t.candidate.apply(s.current, whole.values);
     n.result.parameters = reported(t.candidate, whole.values, whole.uncertainty, point);
+    n.result.no_sigma = whole.no_sigma;
     n.result.simulations += whole.simulations;
   }
   s.named.push_back(n);
@@ -579,6 +598,7 @@ void name_pair(Search& s, const Trial& pair, const std::vector<Trial>& singles) 
                                    {}, pair.point);
     n.result.delta_bic = pair.result.delta_bic;
     n.result.decisive = true;
+    n.result.no_sigma = "the pair's refit on the whole record failed (its fit on the first part has no covariance)";
     s.named.push_back(n);
     at += k;
   }
@@ -672,6 +692,93 @@ std::string swap_correction(Search& s, const std::vector<std::string>& remaining
   return "";
 }
 
+/// The Stribeck scan of a refinement: cell centres of 3 ratios Ts/Tk × 3 Stribeck velocities.
+constexpr int kRefineCells = 3;
+
+// The start of stribeck_<body> refining the i-th named (coulomb_<body>): the named Coulomb level as
+// the kinetic one, the best of the scan's ratios and velocities with the rest named at their
+// values (moving with it, to first order); its parameters as reported, or empty.
+std::vector<Parameter> refinement_start(Search& s, std::size_t i, const EffectCandidate& c) {
+  const auto [at, moving] = without(s, i);
+  const ParameterRange& kinetic = c.ranges[1];
+  const double level = s.named[i].result.parameters.front().value;
+  const double u1 = std::clamp(kinetic.logarithmic ? std::log(level / kinetic.low) / std::log(kinetic.high / kinetic.low)
+                                                   : (level - kinetic.low) / (kinetic.high - kinetic.low), 0.0, 1.0);
+  double best = INFINITY;
+  std::vector<Parameter> start;
+  for (int a = 0; a < kRefineCells; ++a)
+    for (int b = 0; b < kRefineCells; ++b) {
+      const std::vector<double> values{c.ranges[0].value((a + 0.5) / kRefineCells), kinetic.value(u1),
+                                       c.ranges[2].value((b + 0.5) / kRefineCells)};
+      const auto traces = s.simulator.traces(c.apply(at, values), s.o.size());
+      if (!traces) continue;
+      std::vector<double> r = residuals(s.o, *traces, s.o.fit_indices);
+      double sse = sum_of_squares(r);
+      if (moving.cols() > 0 && static_cast<std::size_t>(moving.rows()) == r.size())
+        sse -= (moving.transpose() * Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()))).squaredNorm();
+      if (sse < best)
+        best = sse, start = {{c.ranges[0].name, values[0] * values[1], NAN}, {kinetic.name, values[1], NAN}, {c.ranges[2].name, values[2], NAN}};
+    }
+  return start;
+}
+
+// Friction refined (docs/discrepancy.md, "Stribeck friction"): Stribeck friction contains Coulomb
+// friction (Ts = Tk), so it is no candidate of a round.  Where coulomb_<body> is named and the
+// model still leaves a gap above the noise, stribeck_<body> (in `refinements`) replaces it, from
+// refinement_start, refitted with everything named on the whole record, and is kept when decisive
+// by a round's rule: ΔBIC < −decisive_bic with its two more parameters, the held-out samples
+// confirming (holdout_confirms), no parameter at an end of its range.  Each body is tried once;
+// the attempt is listed last in `round`.  Returns whether Stribeck friction was named.
+bool refine_friction(Search& s, std::vector<std::string>& refinements, std::vector<Candidate>& round) {
+  for (std::size_t i = 0; i < s.named.size() && !s.simulator.budget_reached(); ++i) {
+    const std::string& coulomb = s.named[i].result.effect;
+    if (coulomb.rfind("coulomb_", 0) != 0) continue;
+    const std::string name = "stribeck_" + coulomb.substr(std::string("coulomb_").size());
+    const auto found = std::find(refinements.begin(), refinements.end(), name);
+    if (found == refinements.end()) continue;
+    refinements.erase(found);
+    std::vector<Named> refined = s.named;
+    Named& y = refined[i];
+    y.candidate = candidate_for(name, s.base, s.step);
+    y.result = Candidate{};
+    y.result.effect = name;
+    Candidate& r = refined[i].result;
+    std::optional<ModelPoint> point;
+    std::optional<std::vector<std::vector<double>>> traces;
+    if (s.current.e.delay > 0) r.failure = "refining " + coulomb + ": the delayed model has no Stribeck friction";
+    else try {
+        r.parameters = refinement_start(s, i, y.candidate);
+        if (!r.parameters.empty()) point = joint_refit(s, refined);
+        if (point) traces = s.simulator.traces(*point, s.o.size());
+      } catch (const std::exception& error) {  // a model that cannot be simulated: not refined
+        r.failure = "refining " + coulomb + ": " + error.what();
+      }
+    if (!traces) {
+      if (r.failure.empty()) r.failure = "refining " + coulomb + ": its refit with everything named failed";
+      r.bic = r.rms = r.rms_holdout = INFINITY;
+      round.push_back(r);
+      continue;
+    }
+    const Scores sc = score(s.o, *traces);
+    const int k = s.parameters();
+    r.rms = sc.rms_theta_out, r.rms_fit = sc.rms_fit(), r.rms_holdout = sc.rms_holdout();
+    r.bic = sc.bic(k - static_cast<int>(s.named[i].candidate.ranges.size()) + static_cast<int>(r.parameters.size()));
+    r.delta_bic = r.bic - s.scores.bic(k);
+    for (std::size_t j = 0; j < r.parameters.size(); ++j) {
+      const double u = coordinate_of(refined[i].candidate, r.parameters, j, s.base);
+      r.at_range_edge = r.at_range_edge || u < 1e-3 || u > 1 - 1e-3;
+    }
+    r.decisive = r.delta_bic < -s.options.decisive_bic && holdout_confirms(s, sc) && !r.at_range_edge;
+    round.push_back(r);
+    if (!r.decisive) continue;
+    s.named = std::move(refined);
+    s.current = *point;
+    s.scores = sc;
+    return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 void fit_free_parameters(Search& s, const std::vector<std::string>& free) {
@@ -716,6 +823,11 @@ void fit_free_parameters(Search& s, const std::vector<std::string>& free) {
 void run_search(Search& s, std::vector<std::string> remaining) {
   auto erase = [&](const std::string& name) { remaining.erase(std::remove(remaining.begin(), remaining.end(), name), remaining.end()); };
   for (const Named& n : s.named) erase(n.result.effect);
+  // Stribeck friction refines a named Coulomb friction (refine_friction), never a round's candidate.
+  std::vector<std::string> refinements;
+  std::copy_if(remaining.begin(), remaining.end(), std::back_inserter(refinements),
+               [](const std::string& name) { return name.rfind("stribeck_", 0) == 0; });
+  for (const std::string& name : refinements) erase(name);
   auto go_on = [&](int round) {
     return round < s.options.max_effects + 2 && above_noise(s) &&
            static_cast<int>(s.named.size()) < s.options.max_effects && !remaining.empty() && !s.simulator.budget_reached();
@@ -748,6 +860,7 @@ void run_search(Search& s, std::vector<std::string> remaining) {
     if (!s.rescore()) break;
     replace_needless(s);  // a dropped candidate is not tried again
     if (above_noise(s)) erase(swap_correction(s, remaining));
+    if (above_noise(s) && refine_friction(s, refinements, s.rounds.back())) replace_needless(s);
     // The noise re-read from what the model now leaves: a large gap hides the noise's colour.
     if (const auto traces = s.simulator.traces(s.current, s.o.size())) {
       reestimate_noise(s.o, *traces);

@@ -168,6 +168,10 @@ TEST(DiscrepancyWorkflow, NamesEveryHiddenEffectAndStaysQuietOnCleanData) {
     const Parameters p = numeric::parameters_of(nominal.spec);
     for (double noise : noises) {
       for (const std::string& effect : discrepancy::vocabulary()) {
+        // Stribeck friction is a refinement of a named Coulomb friction (docs/discrepancy.md), not a
+        // round's candidate: a hidden one that Coulomb friction on its body meets at the noise is
+        // rightly named Coulomb friction; its own checks are check_discrepancy_stribeck.cpp.
+        if (effect.rfind("stribeck_", 0) == 0) continue;
         double noise_cap = 0.01;
         const Hidden hidden = calibrated(effect, p, nominal.step, noise_cap);
         generated_data::RecordSpec record = record_of(hidden, nominal.step, std::min(noise, noise_cap), seed);

@@ -94,6 +94,10 @@ double scale_of(const EffectParameterInfo& p, double stiffness) {
     case model::CandidateScale::StepVelocity: return kStep / (2 * std::numbers::pi * std::sqrt((Jm + JL) / K));
     case model::CandidateScale::Absolute: return 1;
     case model::CandidateScale::DampingRatio: return 2 * std::sqrt(stiffness * Jm * JL / (Jm + JL));
+    case model::CandidateScale::KineticRatio: {  // Ts/Tk: times the kinetic level (the next row) at its middle
+      const EffectParameterInfo& kinetic = *(&p + 1);
+      return std::sqrt(kinetic.low * kinetic.high) * scale_of(kinetic, stiffness);
+    }
   }
   return 1;
 }

@@ -259,8 +259,9 @@ std::vector<std::pair<std::string, std::string>> report_files(const model::CaseS
     md << "## Effects named\n\n| effect | parameter | value | ± (1σ) | ΔBIC |\n|---|---|---|---|---|\n";
     for (const Candidate& c : r.effects)
       for (const Parameter& p : c.parameters)
-        md << "| " << c.effect << " | " << p.name << " | " << number(p.value) << " | " << number(p.uncertainty) << " | "
-           << number(c.delta_bic) << " |\n";
+        md << "| " << c.effect << " | " << p.name << " | " << number(p.value) << " | "
+           << (std::isfinite(p.uncertainty) ? number(p.uncertainty) : "— (" + (c.no_sigma.empty() ? "no covariance" : c.no_sigma) + ")")
+           << " | " << number(c.delta_bic) << " |\n";
   }
   if (found) md << "\nThe corrected model: [corrected.toml](corrected.toml) (it loads and simulates as it is).\n\n";
   md << alternatives_section(r);

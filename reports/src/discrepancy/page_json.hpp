@@ -81,11 +81,15 @@ inline RoundsJson rounds_json(const std::vector<std::vector<Candidate>>& rounds,
 /// The effects named, with their parameters, uncertainties and ΔBIC.
 inline nlohmann::json effects_json(const std::vector<Candidate>& effects) {
   nlohmann::json out = nlohmann::json::array();
-  for (const Candidate& c : effects)
+  for (const Candidate& c : effects) {
     out.push_back({{"effect", c.effect},
                    {"parameters", parameter_values_json(c.parameters)},
                    {"uncertainty", parameter_sigmas_json(c.parameters)},
                    {"delta_bic", json_number(c.delta_bic)}});
+    // A σ not reported (null) says why; the key is absent when every σ is a number.
+    const bool all = std::all_of(c.parameters.begin(), c.parameters.end(), [](const Parameter& p) { return std::isfinite(p.uncertainty); });
+    if (!all) out.back()["no_sigma"] = c.no_sigma.empty() ? std::string("no covariance") : c.no_sigma;
+  }
   return out;
 }
 

@@ -94,6 +94,7 @@ struct Candidate {
   int simulations = 0;     ///< simulations its fit used
   double seconds = 0;      ///< time its fit took
   std::string failure;     ///< why its fit failed or stopped early, if it did
+  std::string no_sigma;    ///< a named effect: why a parameter's σ is not reported (empty when every σ is)
 };
 
 /// A stretch of the record between events of the simulated model.

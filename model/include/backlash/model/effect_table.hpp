@@ -37,7 +37,8 @@
 //                the model's own scale (CandidateScale below), logarithmic or linear, and the
 //                name of the fitted parameter on the page and in the JSON
 // Across parameters: an effect with a `static` and a `kinetic` level (Stribeck friction) needs
-// kinetic <= static (the reader and numeric::effect_scale_problem refuse the rest).
+// kinetic <= static (the reader and numeric::effect_scale_problem refuse the rest): its candidate
+// fits the static level as a ratio to the kinetic one (KineticRatio, LOW = 1).
 #define BACKLASH_EFFECT_PARAMETERS(X)                                                                            \
   X(coulomb_motor, "coulomb_motor", "coulomb_motor", "coulomb_motor", "T_{m}", "Coulomb friction on the motor", \
     "N·m", 0.0, NonNegative, "negative Coulomb torque; a friction torque must be >= 0",                          \
@@ -61,22 +62,22 @@
     "", StepTorque, -0.2, 0.2, false, "torque")                                                            \
   X(stribeck_motor_static, "stribeck_motor", "static", "stribeck_motor_static", "T_{sm}",                   \
     "static friction on the motor", "N·m", 0.0, NonNegative,                                                       \
-    "negative static friction; a friction torque must be >= 0", StepTorque, 1e-4, 0.3, true, "static")           \
+    "negative static friction; a friction torque must be >= 0", KineticRatio, 1.0, 4.0, true, "static")         \
   X(stribeck_motor_kinetic, "stribeck_motor", "kinetic", "stribeck_motor_kinetic", "T_{km}",                \
     "kinetic friction on the motor", "N·m", 0.0, NonNegative,                                                      \
     "negative kinetic friction; a friction torque must be >= 0", StepTorque, 1e-4, 0.3, true, "kinetic")         \
   X(stribeck_motor_velocity, "stribeck_motor", "velocity", "stribeck_motor_velocity", "v_{sm}",             \
     "Stribeck velocity of the motor", "rad/s", ::backlash::model::kAbsent, Positive,                              \
-    "non-positive Stribeck velocity; it must be > 0", StepVelocity, 1e-3, 1.0, true, "velocity") \
+    "non-positive Stribeck velocity; it must be > 0", StepVelocity, 1e-3, 0.5, true, "velocity") \
   X(stribeck_load_static, "stribeck_load", "static", "stribeck_load_static", "T_{sL}",                   \
     "static friction on the load", "N·m", 0.0, NonNegative,                                                       \
-    "negative static friction; a friction torque must be >= 0", StepTorque, 1e-4, 0.3, true, "static")           \
+    "negative static friction; a friction torque must be >= 0", KineticRatio, 1.0, 4.0, true, "static")         \
   X(stribeck_load_kinetic, "stribeck_load", "kinetic", "stribeck_load_kinetic", "T_{kL}",                \
     "kinetic friction on the load", "N·m", 0.0, NonNegative,                                                      \
     "negative kinetic friction; a friction torque must be >= 0", StepTorque, 1e-4, 0.3, true, "kinetic")         \
   X(stribeck_load_velocity, "stribeck_load", "velocity", "stribeck_load_velocity", "v_{sL}",             \
     "Stribeck velocity of the load", "rad/s", ::backlash::model::kAbsent, Positive,                              \
-    "non-positive Stribeck velocity; it must be > 0", StepVelocity, 1e-3, 1.0, true, "velocity")
+    "non-positive Stribeck velocity; it must be > 0", StepVelocity, 1e-3, 0.5, true, "velocity")
 
 // ------------------------------------------------------------------ the effects
 //
@@ -94,8 +95,8 @@
   E("compliance", true, true, 5, 0)            \
   E("delay", false, false, 6, 3)               \
   E("torque_offset", false, false, 8, 2)       \
-  E("stribeck_motor", false, false, 0, 0)      \
-  E("stribeck_load", false, false, 0, 0)
+  E("stribeck_motor", false, false, 9, 0)      \
+  E("stribeck_load", false, false, 10, 0)
 
 namespace backlash::model {
 
@@ -118,6 +119,7 @@ enum class CandidateScale {
   Absolute,      ///< 1: the range as written
   DampingRatio,  ///< the range is ζ; the damping is 2ζ·sqrt(kc·Jm·JL/(Jm + JL)), kc the stiffness fitted with it
   StepVelocity,  ///< the step over the servo period, |step|/(2π·sqrt((Jm + JL)/K)) [rad/s]
+  KineticRatio,  ///< the range is Ts/Tk >= 1; the static level is that ratio times the kinetic level fitted with it (the next row): Ts >= Tk at every point a fit tries
 };
 
 /// The effect parameters, in the table's order.
