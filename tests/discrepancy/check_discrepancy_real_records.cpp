@@ -1,7 +1,7 @@
 // The discrepancy workflow (discrepancy.hpp) on records as real machines make them (issue 21):
 // made by the INDEPENDENT odeint simulator (generator.hpp) — never by the closed-form code the
 // workflow fits with — with several effects at once, errors in the nominal parameters, an effect
-// outside the vocabulary (a sensor drift), coloured noise, spikes, a coarse encoder, jittered
+// outside the vocabulary (sensor drifts, a sinusoidal pickup at two frequencies in the full matrix), coloured noise, spikes, a coarse encoder, jittered
 // time stamps and a late start.
 //   Item1*  a nominal parameter's error is reported as a correction, not as an effect; [fit]
 //           fixed keeps a parameter, [fit] free fits it first;
@@ -58,7 +58,9 @@ struct Truth {
   Effects effects;
   std::set<std::string> named;        ///< the effects the workflow should name
   std::set<std::string> corrections;  ///< the parameters it should correct
-  bool outside = false;               ///< an effect outside the vocabulary
+  bool outside = false;               ///< an effect outside the vocabulary: a sensor drift, or
+  double drift = 0.002;               ///< of this rate [rad/s] (2 mrad/s unless said), or
+  double hum = 0, hum_frequency = 0;  ///< a sinusoidal pickup on the sensor [rad, Hz]
 };
 
 /// Effect sizes on case V's scale (K·|step| = 0.62, servo period ≈ 6.4 s): each stands tens of
@@ -107,7 +109,8 @@ generated_data::RecordSpec record_of(const Truth& t, const Condition& c, std::ui
   r.jitter = c.jitter;
   r.start = c.start;
   r.seed = seed;
-  if (t.outside) r.drift = 0.002;  // a sensor drift of 2 mrad/s: no effect of the vocabulary makes it
+  // A sensor drift or a sinusoidal pickup on the sensor: no effect of the vocabulary makes either.
+  if (t.outside) r.drift = t.hum > 0 ? 0 : t.drift, r.hum = t.hum, r.hum_frequency = t.hum_frequency;
   return r;
 }
 
@@ -323,6 +326,17 @@ std::vector<std::pair<Truth, Condition>> matrix(bool full) {
   drift.label = "sensor drift";
   drift.outside = true;
   out.push_back({drift, {}});
+  if (full) {  // more kinds outside the vocabulary: a slower drift of the other sign, a pickup at two frequencies
+    Truth slow = drift;
+    slow.label = "sensor drift -0.5 mrad/s", slow.drift = -0.0005;
+    out.push_back({slow, {}});
+    for (const double f : {0.37, 1.7}) {
+      Truth hum = drift;
+      hum.label = f < 1 ? "sensor hum 0.37 Hz" : "sensor hum 1.7 Hz";
+      hum.hum = 10 * 0.001 * kStep, hum.hum_frequency = f;  // 10 noise levels
+      out.push_back({hum, {}});
+    }
+  }
   std::vector<Condition> conditions(7);
   conditions[0].label = "coloured 10", conditions[0].correlation = 10;
   conditions[1].label = "spikes", conditions[1].spikes = 0.005;

@@ -43,7 +43,7 @@ measurements::MeasuredRecord generate_record(const RecordSpec& spec) {
   std::vector<double> motor, load;
   for (const numeric::TrajectorySample& s : r.samples) {
     record.t.push_back(s.t);
-    const double drift = spec.drift * s.t;
+    const double drift = spec.drift * s.t + spec.hum * std::sin(2 * M_PI * spec.hum_frequency * s.t);
     record.theta_out.push_back(measure(s.theta_o + drift));
     motor.push_back(measure(s.theta_m + drift));
     load.push_back(measure(s.theta_L + drift));

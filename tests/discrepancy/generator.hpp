@@ -32,6 +32,7 @@ struct RecordSpec {
   double jitter = 0;              ///< each time stamp moved by up to ±jitter sample intervals (uniform)
   double start = 0;               ///< samples before this time are dropped (a record started late)
   double drift = 0;               ///< a sensor drift [rad/s] added to every column (outside the vocabulary)
+  double hum = 0, hum_frequency = 0;  ///< a sinusoidal pickup hum·sin(2π·f·t) [rad] on every column (outside the vocabulary)
 };
 
 /// The record, or throws std::runtime_error when the simulation does not end normally.
