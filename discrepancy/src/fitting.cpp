@@ -386,6 +386,25 @@ void prepare_candidate(Simulator& simulator, const EffectCandidate& c, const Mod
   simulator.prepare(corners);
 }
 
+namespace {
+
+// The scale of the residual where a fit starts: its start, or the base model (1 when that model
+// cannot be simulated).
+double starting_residual_scale(Simulator& simulator, const Observations& data, const ModelPoint& base,
+                               const EffectCandidate& c, const std::vector<double>* start_u,
+                               const std::vector<std::size_t>& samples) {
+  ModelPoint from = base;
+  if (start_u) {
+    std::vector<double> values;
+    for (std::size_t i = 0; i < c.ranges.size(); ++i) values.push_back(c.ranges[i].value((*start_u)[i]));
+    from = c.apply(base, values);
+  }
+  if (const auto traces = simulator.traces(from, samples.back() + 1)) return residual_scale(residuals(data, *traces, samples));
+  return 1;
+}
+
+}  // namespace
+
 // The fit grows its horizon: scanned and refined up to a quarter servo period past the base
 // model's first departure from the record (where the response still depends smoothly on the
 // parameter — over a long record a lively gear's response, say with a high restitution, is
@@ -404,16 +423,7 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
   // starts (its start, or the base model) — an M-estimate with a preliminary scale: at the noise
   // level the noise's σ (a spike is an outlier), over a systematic gap the gap's size (a gap the
   // model does not yet explain is no outlier: the fit then minimises the sum of squares its score is).
-  double loss_scale = 1;
-  {
-    ModelPoint from = base;
-    if (start_u) {
-      std::vector<double> values;
-      for (std::size_t i = 0; i < k; ++i) values.push_back(c.ranges[i].value((*start_u)[i]));
-      from = c.apply(base, values);
-    }
-    if (const auto traces = simulator.traces(from, samples.back() + 1)) loss_scale = residual_scale(residuals(data, *traces, samples));
-  }
+  const double loss_scale = starting_residual_scale(simulator, data, base, c, start_u, samples);
   // The horizons: from a quarter servo period past where the base model first leaves the noise
   // band (the first events that tell the parameter apart), growing by half each stage.
   const double t0 = data.t.front(), t_end = data.t.back();
