@@ -27,18 +27,10 @@ std::vector<std::vector<double>> EffectCandidate::scan() const {
   if (ranges.size() == 1) {
     constexpr int n = 40;  // fine: with many bounces or events the cost has many shallow valleys
     for (int i = 0; i < n; ++i) points.push_back({i / double(n - 1)});
-  } else if (ranges.size() == 2) {
+  } else {
     constexpr int n0 = 7, n1 = 5;
     for (int i = 0; i < n0; ++i)
       for (int j = 0; j < n1; ++j) points.push_back({i / double(n0 - 1), j / double(n1 - 1)});
-  } else {
-    // Three (Stribeck friction: Ts/Tk, Tk, vs): cell centres, the middle parameter (the kinetic
-    // level, where a Coulomb friction's scan would bracket) the finest; Ts/Tk = 1 (at the range's
-    // end, Coulomb friction) is not a start.
-    constexpr int n0 = 3, n1 = 8, n2 = 3;
-    for (int j = 0; j < n1; ++j)
-      for (int i = 0; i < n0; ++i)
-        for (int l = 0; l < n2; ++l) points.push_back({(i + 0.5) / n0, (j + 0.5) / n1, (l + 0.5) / n2});
   }
   return points;
 }

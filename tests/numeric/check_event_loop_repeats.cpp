@@ -7,6 +7,8 @@
 //                                    event, a flight's start x(0) both its search and its certified
 //                                    departure (main evaluated each twice: 1 of ~11 evaluations per
 //                                    event).
+#include "counting_evaluator.hpp"
+
 #include "backlash/model/case_spec.hpp"
 #include "backlash/numeric/evaluator.hpp"
 #include "backlash/numeric/hybrid_simulation.hpp"
@@ -14,52 +16,16 @@
 
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cstdio>
 #include <memory>
-#include <set>
 #include <string>
-#include <utility>
-
-namespace {
 
 using namespace backlash;
-
-// Forwards to `inner`, counting the evaluations whose arguments were already evaluated since `clear`.
-class RepeatCountingEvaluator final : public numeric::SegmentEvaluator {
- public:
-  explicit RepeatCountingEvaluator(numeric::EvaluatorPtr inner) : inner_(std::move(inner)) {}
-  std::string name() const override { return inner_->name(); }
-  std::string kind() const override { return inner_->kind(); }
-  const numeric::Parameters& parameters() const override { return inner_->parameters(); }
-  numeric::BranchSelection branches() const override { return inner_->branches(); }
-  double cot_phi() const override { return inner_->cot_phi(); }
-  numeric::FreeState free_state(double t, double v0) const override {
-    note({0, t, v0, 0});
-    return inner_->free_state(t, v0);
-  }
-  numeric::ContactState contact_state(double t, double x0, double v0) const override {
-    note({1, t, x0, v0});
-    return inner_->contact_state(t, x0, v0);
-  }
-  void clear() const { seen_.clear(); }
-  mutable long evaluations = 0, repeats = 0;
-
- private:
-  void note(const std::array<double, 4>& call) const {
-    ++evaluations;
-    if (!seen_.insert(call).second) ++repeats;
-  }
-  numeric::EvaluatorPtr inner_;
-  mutable std::set<std::array<double, 4>> seen_;
-};
-
-}  // namespace
 
 TEST(EventLoopRepeats, item1_no_point_evaluated_twice) {
   for (const std::string id : {"III", "IV", "V", "VI", "VII", "VIII"}) {
     const model::CaseSpec spec = model::load_case(id);
-    const auto counter = std::make_shared<const RepeatCountingEvaluator>(numeric::case_evaluator(spec));
+    const auto counter = std::make_shared<const backlash::testing::CountingEvaluator>(numeric::case_evaluator(spec), true);
     const numeric::ValidationResult validated = numeric::validate(counter);
     numeric::SimulationOptions o;
     o.t_end = 60;
