@@ -3,12 +3,15 @@
 #include "backlash/numeric/first_crossing.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
 #include "hybrid/gap_events.hpp"
+#include "hybrid/quiet_tail.hpp"
+#include "hybrid/unit_gap_profile.hpp"
 
 #include <boost/math/tools/roots.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <string>
 
 namespace backlash::numeric {
@@ -127,28 +130,54 @@ DividingLinePoint dividing_line_point(const ValidatedEvaluator& evaluator, doubl
 
 namespace {
 
-// The unit flight.  From the separation line the free-mode deviations from θR are linear in
-// θ̇m0 (θR cancels in the gap), so gap(t; θ̇m0) = θ̇m0·f(t) with f = gap(t; 1): one profile
-// serves the whole dividing line.  Its knots are the certified departure t0, the certified
-// zeros of f' (in order), and `end`, the first return of f to 0 (or the horizon); f is
-// monotone between consecutive knots.  A search that runs out of its budget (SearchBudgetExhausted)
-// still certifies the span before where it stopped: the profile then ends there (`complete` false,
-// `work_limit` the reason), and decides the levels it reaches before that end.
-struct UnitGapProfile {
-  bool valid = false;
-  double end = 0;
-  bool returns = false;  ///< f returns to 0 at `end` (recontact on the face left)
-  bool complete = true;  ///< `end` is the return or the horizon (not where a search stopped)
-  std::string work_limit;
-  std::vector<double> knots, values;
-};
+using detail::UnitGapProfile;
 
-UnitGapProfile unit_gap_profile(const ValidatedEvaluator& evaluator, double horizon) {
+// A nearly frictionless load (FL → 0) stretches the horizon to 40·JL/FL while the motor settles
+// within its own time scale: then, after a while, f and f' keep one sign to the horizon
+// (quiet_tail.hpp).  The first such time certified, tried at the ends of the searches' windows 3,
+// 5, 7, … from t0 (7, 31, 127, … first windows on), while short of an eighth of the horizon (a
+// shorter horizon gains nothing); each try within kQuietTailBudget intervals.
+constexpr long kQuietTailBudget = 400;
+
+std::optional<double> quiet_start(const ValidatedEvaluator& evaluator, double t0, double horizon) {
+  const Parameters& p = evaluator.parameters();
+  const LinearSegment free = free_mode_segment(p);
+  const double window = detail::gap_witness_mode(free, servo_time_unit(p)).first_window;
+  const std::function<SmallVector(double)> state = gap_witness(evaluator, 1.0, 0).state;
+  for (int k = 3; k < 60; k += 2) {
+    const double from = t0 + window * (std::ldexp(1.0, k) - 1);
+    if (!(from <= horizon / 8)) break;
+    if (detail::gap_moves_away_from(free, state, evaluator.free_state(from, 1.0).gap, from, horizon, servo_time_unit(p),
+                                    kQuietTailBudget))
+      return from;
+  }
+  return std::nullopt;
+}
+
+// The first crossing of `w` in (lo, hi] as first_crossing(w, lo, hi) finds it, with w certified
+// free of zeros from `quiet` to hi: searched on (lo, quiet] first, where none means none at all,
+// and a crossing there found again by the whole search (which stops at it: the same bits).
+std::optional<Crossing> crossing_before_quiet_tail(const LinearWitness& w, double lo, double hi,
+                                                   const std::optional<double>& quiet) {
+  if (quiet && *quiet > lo && *quiet < hi) {
+    try {
+      if (!first_crossing(w, lo, *quiet)) return std::nullopt;
+    } catch (const SearchBudgetExhausted&) {
+      // the whole search answers (or spends its own budget)
+    }
+  }
+  return first_crossing(w, lo, hi);
+}
+
+}  // namespace
+
+UnitGapProfile detail::unit_gap_profile(const ValidatedEvaluator& evaluator, double horizon, bool quiet_tail) {
   UnitGapProfile profile;
   const double unit = 1.0;
   const std::optional<double> t0 = return_search_start(evaluator, unit);
   if (!t0) return profile;
   const LinearWitness gap = gap_witness(evaluator, unit, 0);
+  const std::optional<double> quiet = quiet_tail ? quiet_start(evaluator, *t0, horizon) : std::nullopt;
   std::optional<Crossing> back;
   const auto stopped = [&profile, horizon](const SearchBudgetExhausted& budget, double from) {
     profile.complete = false;
@@ -157,7 +186,7 @@ UnitGapProfile unit_gap_profile(const ValidatedEvaluator& evaluator, double hori
   };
   profile.valid = true;
   try {
-    back = first_crossing(gap, *t0, horizon);
+    back = crossing_before_quiet_tail(gap, *t0, horizon, quiet);
     profile.end = back ? back->t : horizon;
   } catch (const SearchBudgetExhausted& budget) {
     stopped(budget, *t0);  // f ≠ 0 on (t0, end]: no return there
@@ -181,7 +210,7 @@ UnitGapProfile unit_gap_profile(const ValidatedEvaluator& evaluator, double hori
   double t = *t0;
   try {
     while (t < profile.end) {
-      const auto critical = first_crossing(slope, t, profile.end);
+      const auto critical = crossing_before_quiet_tail(slope, t, profile.end, quiet);
       if (!critical) break;
       add(critical->t);
       t = critical->t + 1e-12 * std::max(1.0, critical->t);
@@ -193,6 +222,8 @@ UnitGapProfile unit_gap_profile(const ValidatedEvaluator& evaluator, double hori
   if (profile.complete || profile.end > profile.knots.back()) add(profile.end);
   return profile;
 }
+
+namespace {
 
 // First t with f(t) = level on the profile (monotone pieces in order), or nothing.
 std::optional<Crossing> first_level_crossing(const ValidatedEvaluator& evaluator, const UnitGapProfile& profile, double level) {
@@ -233,7 +264,7 @@ DividingLinePoint point_from_profile(const ValidatedEvaluator& evaluator, const 
 }
 
 DividingLinePoint point_by_profile(const ValidatedEvaluator& evaluator, double v0, const TraceOptions& options) {
-  return point_from_profile(evaluator, unit_gap_profile(evaluator, horizon_of(evaluator.parameters(), options)), v0);
+  return point_from_profile(evaluator, detail::unit_gap_profile(evaluator, horizon_of(evaluator.parameters(), options)), v0);
 }
 
 }  // namespace
@@ -249,7 +280,7 @@ DividingLines trace_dividing_lines(const ValidatedEvaluator& evaluator, const st
   DividingLines lines;
   lines.cot_phi = evaluator.cot_phi();
   lines.horizon = horizon_of(p, options);
-  const UnitGapProfile profile = unit_gap_profile(evaluator, lines.horizon);
+  const UnitGapProfile profile = detail::unit_gap_profile(evaluator, lines.horizon);
   // Threshold: b / sup f before the return; none when f still rises at the horizon (it grows without bound).
   if (profile.valid && profile.complete && p.backlash > 0) {
     double sup = 0;

@@ -1,0 +1,110 @@
+// Issue 20, slider drags at ≥ 30 fps: the dividing lines of a nearly frictionless load.  Dragging
+// FL from 0 reaches FL = 1e-5, where the unit gap profile (numeric/hybrid/dividing_lines.cpp)
+// searched the gap's return and its slope's zeros over the horizon 40·JL/FL (3.2·10⁶ s on case
+// IV) in intervals of the free mode's growth bound: ~2·10⁶ intervals, its budget (main).  Now its
+// searches stop where the gap and its slope are certified to keep one sign up to the horizon, on
+// the free mode's structure (numeric/hybrid/quiet_tail.hpp):
+//   item20_case_IV_dividing_lines_cost_set_by_the_motor  the closed-form evaluations of case IV's
+//        dividing lines (both faces) at FL = 1e-5 and 1e-6: at most those over the motor's own
+//        horizon (40 of the slowest time scales without the load's friction: 400 s) plus, per
+//        doubling of the horizon beyond it, one window of the certified search (main: ~4·10⁶);
+//   item20_profiles_bit_for_bit_with_the_whole_searches  on random free modes (either shaft
+//        measured, FL from 1e-3 to 1), the profile — knots, values, end, return — bit for bit the
+//        one of the whole searches, and the searches' stop taken on most of those with FL ≤ 1e-2;
+//   item20_quiet_tail_bound_holds  the bound on |f''''| the certificate rests on holds at sampled
+//        points of random flights (beyond the samples' own rounding).
+#include "counting_evaluator.hpp"
+
+#include "backlash/numeric/dividing_lines.hpp"
+#include "backlash/numeric/evaluator.hpp"
+#include "backlash/numeric/segment_dynamics.hpp"
+#include "backlash/numeric/validation.hpp"
+#include "hybrid/linear_flight.hpp"
+#include "hybrid/quiet_tail.hpp"
+#include "hybrid/unit_gap_profile.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace backlash;
+using namespace backlash::numeric;
+
+// The thesis's cases II–IV (cases/*.toml: K = 1, b = 0.3) with the load's friction FL, in error
+// coordinates (θR = 0) as the facade runs them.
+Parameters thesis_case(int number, double FL) {
+  Parameters p;
+  p.K = 1, p.theta_R = 0, p.backlash = 0.3, p.FL = FL;
+  p.Jm = number == 4 ? 0.2 : 0.5, p.Fm = 0.2, p.JL = number == 4 ? 0.8 : 0.5;
+  p.measured_at = number == 2 ? model::MeasuredAt::Motor : model::MeasuredAt::Load;
+  return p;
+}
+
+// The explorer's grid: the default one and its negatives (both faces).
+std::vector<double> both_faces() {
+  std::vector<double> v = default_dividing_line_grid();
+  const std::size_t n = v.size();
+  for (std::size_t i = 0; i < n; ++i) v.push_back(-v[i]);
+  return v;
+}
+
+struct Counted {
+  std::shared_ptr<const backlash::testing::CountingEvaluator> counter;
+  ValidationResult validated;
+};
+
+Counted counted(const Parameters& p) {
+  auto counter = std::make_shared<const backlash::testing::CountingEvaluator>(parametric_evaluator(p));
+  ValidationResult validated = validate(counter);
+  return {counter, std::move(validated)};
+}
+
+// Closed-form evaluations of the dividing lines of both faces over `horizon` (0: the default).
+long trace_cost(const Counted& c, double horizon, DividingLines* lines = nullptr) {
+  TraceOptions options;
+  options.horizon = horizon;
+  const long before = c.counter->evaluations;
+  const DividingLines traced = trace_dividing_lines(c.validated.evaluator(), both_faces(), options);
+  if (lines) *lines = traced;
+  return c.counter->evaluations - before;
+}
+
+// Closed-form evaluations of the unit gap profile over `horizon`.
+long profile_cost(const Counted& c, double horizon, bool quiet_tail = true) {
+  const long before = c.counter->evaluations;
+  detail::unit_gap_profile(c.validated.evaluator(), horizon, quiet_tail);
+  return c.counter->evaluations - before;
+}
+
+TEST(DividingLinesSmallFriction, item20_case_IV_dividing_lines_cost_set_by_the_motor) {
+  for (double FL : {1e-5, 1e-6}) {
+    const Parameters p = thesis_case(4, FL);
+    const Counted c = counted(p);
+    ASSERT_TRUE(c.validated.passed());
+    Parameters frictionless = p;
+    frictionless.FL = 0;
+    const double motor_horizon = 40 * slowest_time_scale(frictionless), horizon = 40 * slowest_time_scale(p);
+    DividingLines lines;
+    const long cost = trace_cost(c, 0, &lines), motor_cost = trace_cost(c, motor_horizon);
+    const long profile = profile_cost(c, horizon), motor_profile = profile_cost(c, motor_horizon);
+    const double doublings = std::ceil(std::log2(horizon / motor_horizon));
+    std::printf("case IV, FL = %g: horizon %g s: %ld evaluations (the profile %ld); the motor's horizon %g s: %ld (%ld)\n",
+                FL, horizon, cost, profile, motor_horizon, motor_cost, motor_profile);
+    EXPECT_TRUE(lines.work_limit.empty()) << lines.work_limit;
+    // The profile: beyond the motor's horizon only the certificate's windows, each decided by an
+    // interval or two (two samples at most).
+    EXPECT_LE(profile, motor_profile + 2 * doublings) << "FL = " << FL;
+    // The lines: the profile and each point's root in its bracket, which ends at the horizon (a
+    // few more iterations of TOMS 748 per point for the wider bracket, as before).
+    EXPECT_LE(cost, 2 * motor_cost) << "FL = " << FL;
+  }
+}
+
+}  // namespace
