@@ -107,4 +107,90 @@ TEST(DividingLinesSmallFriction, item20_case_IV_dividing_lines_cost_set_by_the_m
   }
 }
 
+// A random free mode: either shaft measured, the thesis's scales, FL log-uniform in [1e-3, 1].
+Parameters random_case(std::mt19937_64& random) {
+  const auto log_uniform = [&random](double lo, double hi) {
+    return lo * std::pow(hi / lo, std::uniform_real_distribution<double>(0, 1)(random));
+  };
+  Parameters p;
+  p.measured_at = random() % 2 ? model::MeasuredAt::Motor : model::MeasuredAt::Load;
+  p.Jm = log_uniform(0.1, 2), p.JL = log_uniform(0.1, 2), p.Fm = log_uniform(0.02, 1), p.K = log_uniform(0.3, 3);
+  p.FL = log_uniform(1e-3, 1), p.backlash = 0.3, p.theta_R = 0;
+  return p;
+}
+
+TEST(DividingLinesSmallFriction, item20_profiles_bit_for_bit_with_the_whole_searches) {
+  std::mt19937_64 random(2020);
+  int compared = 0, stopped = 0, light = 0, turns = 0;
+  for (int i = 0; i < 60 && compared < 40; ++i) {
+    const Parameters p = random_case(random);
+    const Counted c = counted(p);
+    if (!c.validated.passed()) continue;
+    const double horizon = 40 * slowest_time_scale(p);
+    const long before = c.counter->evaluations;
+    const detail::UnitGapProfile quiet = detail::unit_gap_profile(c.validated.evaluator(), horizon);
+    const long quiet_cost = c.counter->evaluations - before;
+    const detail::UnitGapProfile whole = detail::unit_gap_profile(c.validated.evaluator(), horizon, false);
+    const long whole_cost = c.counter->evaluations - before - quiet_cost;
+    const std::string label = "set " + std::to_string(i) + " (FL = " + std::to_string(p.FL) + ")";
+    EXPECT_EQ(quiet.valid, whole.valid) << label;
+    EXPECT_EQ(quiet.end, whole.end) << label;
+    EXPECT_EQ(quiet.returns, whole.returns) << label;
+    EXPECT_EQ(quiet.complete, whole.complete) << label;
+    EXPECT_EQ(quiet.knots, whole.knots) << label;
+    EXPECT_EQ(quiet.values, whole.values) << label;
+    ++compared;
+    turns += whole.knots.size() > 3;
+    if (p.FL <= 1e-2) {
+      ++light;
+      stopped += 4 * quiet_cost < whole_cost;
+    }
+  }
+  std::printf("%d profiles compared (%d with turns of the gap); FL <= 1e-2: %d, the searches stopped early on %d\n",
+              compared, turns, light, stopped);
+  EXPECT_GE(compared, 30);
+  EXPECT_GE(turns, 5);  // profiles with turns are exercised
+  EXPECT_GE(2 * stopped, light);  // the stop is taken on most light loads
+}
+
+// The bound on sup |f| over [a, b] ⊂ [T, ∞) from x(T) alone, against f = e·A²(A x + c)
+// (e = (0, −1, 0, 1)) at sampled points of random flights (LinearFlight from random states, the
+// separation line's unit flight among them), beyond those samples' own rounding (1e-13 of their
+// terms' size: a few hundred ulps).
+TEST(DividingLinesSmallFriction, item20_quiet_tail_bound_holds) {
+  std::mt19937_64 random(2021);
+  std::uniform_real_distribution<double> unit(0, 1), state(-2, 2);
+  long checked = 0, resolved = 0;
+  for (int i = 0; i < 200; ++i) {
+    const Parameters p = random_case(random);
+    const LinearSegment free = free_mode_segment(p);
+    SmallVector x0(4);
+    if (i % 4 == 0) x0 << 0, 1, 0, 1; else x0 << state(random), state(random), state(random), state(random);
+    const LinearFlight flight(free, x0);
+    const double T = 50 * unit(random);
+    const auto bound = detail::gap_slope_third_derivative_bound(free, flight.state(T), T);
+    ASSERT_TRUE(bound) << "set " << i;
+    SmallRow e = SmallRow::Zero(4);
+    e(1) = -1, e(3) = 1;
+    const SmallRow eA2 = e * free.A * free.A;
+    const SmallRow size_row = e.cwiseAbs() * free.A.cwiseAbs() * free.A.cwiseAbs();
+    for (int j = 0; j < 5; ++j) {
+      const double a = T + std::pow(10.0, 4 * unit(random) - 1) * unit(random);
+      const double b = a + std::pow(10.0, 4 * unit(random) - 2);
+      const double M = bound(a, b);
+      for (int k = 0; k <= 20; ++k) {
+        const double s = a + (b - a) * k / 20;
+        const SmallVector x = flight.state(s);
+        const double fourth = eA2.dot(free.A * x + free.c);
+        const double rounding = 1e-13 * size_row.dot(free.A.cwiseAbs() * x.cwiseAbs() + free.c.cwiseAbs());
+        EXPECT_LE(std::fabs(fourth), M + rounding) << "set " << i << ", s = " << s << " in [" << a << ", " << b << "], T = " << T;
+        ++checked;
+        resolved += rounding < 0.1 * M;
+      }
+    }
+  }
+  std::printf("%ld points checked, %ld where the bound is ten times the samples' rounding\n", checked, resolved);
+  EXPECT_GE(2 * resolved, checked);
+}
+
 }  // namespace
