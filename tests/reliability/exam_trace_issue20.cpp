@@ -2,7 +2,8 @@
 //   item1: case I at θR = 0.7, 0.95, 0.99 — the dividing lines' search ran in absolute
 //          coordinates, where θR's rounding was a floor the certified search could not pass.
 //   item2: case IV with FL = 1e-5 (horizon 40·JL/FL) — the search's budget is a work limit:
-//          decided points answer, an undecidable one has status work_limit and the command exits 3.
+//          decided points answer, an undecidable one (case II with a frictionless motor, FL =
+//          1e-5) has status work_limit and the command exits 3.
 // Through the built CLI; BACKLASH_CLI_UNDER_TEST overrides the binary (to see main's fail).
 #include "scratch_folder.hpp"
 
@@ -18,6 +19,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -48,25 +50,34 @@ CliRun run(const std::string& arguments) {
   return r;
 }
 
-/// The case file `id` (cases/) with `key = value` replaced in `section` ("" for the top level).
-fs::path edited_case(const std::string& id, const std::string& section, const std::string& key, const std::string& value,
-                     const std::string& name) {
+struct Edit {
+  std::string section, key, value;
+};
+
+/// The case file `id` (cases/) with each edit's `key = value` replaced in its `section` ("" for the top level).
+fs::path edited_case(const std::string& id, const std::vector<Edit>& edits, const std::string& name) {
   std::ifstream in(fs::path(BACKLASH_SOURCE_DIR) / "cases" / (id + ".toml"));
   std::ostringstream edited;
   std::string line, current;
-  bool replaced = false;
+  std::size_t replaced = 0;
   while (std::getline(in, line)) {
     if (!line.empty() && line[0] == '[') current = line.substr(1, line.find(']') - 1);
-    if (current == section && line.rfind(key + " =", 0) == 0) {
-      line = key + " = " + value;
-      replaced = true;
-    }
+    for (const Edit& e : edits)
+      if (current == e.section && line.rfind(e.key + " =", 0) == 0) {
+        line = e.key + " = " + e.value;
+        ++replaced;
+      }
     edited << line << "\n";
   }
-  EXPECT_TRUE(replaced) << key << " not found in case " << id;
+  EXPECT_EQ(replaced, edits.size()) << "a key not found in case " << id;
   const fs::path file = scratch_folder("trace20") / (name + ".toml");
   std::ofstream(file) << edited.str();
   return file;
+}
+
+fs::path edited_case(const std::string& id, const std::string& section, const std::string& key, const std::string& value,
+                     const std::string& name) {
+  return edited_case(id, {{section, key, value}}, name);
 }
 
 nlohmann::json parsed(const CliRun& r) {
@@ -106,9 +117,10 @@ TEST(TraceIssue20, item1_trace_reference_below_one_answers) {
   }
 }
 
-// FL = 1e-5: the horizon 40·JL/FL = 3.2e6 s is more than the certified search's budget covers,
-// but the thesis's grid recombines within the first seconds, inside the span the search did
-// certify: every point answers (exit 0), the gap at the impact is the backlash (θL − θm = b).
+// FL = 1e-5: the horizon 40·JL/FL = 3.2e6 s was more than the certified search's budget covered
+// (its searches now stop where the gap is certified to move away for good: dividing_lines.hpp),
+// and the thesis's grid recombines within the first seconds: every point answers (exit 0), the
+// gap at the impact is the backlash (θL − θm = b).
 TEST(TraceIssue20, item2_trace_long_horizon_decides_the_grid) {
   const fs::path file = edited_case("IV", "load", "F", "1e-5", "IV_FL_1e-5");
   const CliRun r = run(file.string() + " --json");
@@ -123,11 +135,14 @@ TEST(TraceIssue20, item2_trace_long_horizon_decides_the_grid) {
   }
 }
 
-// A θ̇m0 so small that its gap reaches the face only after the span the budget certifies: that
-// point is a work limit (status work_limit, no states), the other answers, the document says
-// why, and the command exits 3 with the reason on stderr — never exit 1.
+// A θ̇m0 so small that its gap reaches the face only after the span the budget certifies — a
+// motor without friction (case II with Fm = 0) never settles, so no quiet tail cuts the search
+// over the horizon of FL = 1e-5 (8e6 s) short: that point is a work limit (status work_limit, no
+// states), the other answers, the document says why, and the command exits 3 with the reason on
+// stderr — never exit 1.  (Case IV at FL = 1e-5 was this example before its searches stopped at
+// its quiet tail: its θ̇m0 = 1e-13 is now "none", its gap short of the face at the horizon.)
 TEST(TraceIssue20, item2_trace_undecidable_point_is_work_limit_exit_3) {
-  const fs::path file = edited_case("IV", "load", "F", "1e-5", "IV_FL_1e-5_small");
+  const fs::path file = edited_case("II", {{"motor", "F", "0"}, {"load", "F", "1e-5"}}, "II_Fm_0_FL_1e-5_small");
   const CliRun r = run(file.string() + " --v0 1,1e-13 --json");
   EXPECT_EQ(r.exit_code, 3) << r.err;
   EXPECT_NE(r.err.find("1 of 2 dividing-line points unresolved (work_limit)"), std::string::npos) << r.err;

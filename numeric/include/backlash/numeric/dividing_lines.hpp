@@ -23,7 +23,10 @@
 // ran out of intervals.  A point its search cannot decide within CrossingOptions::max_intervals
 // comes back with status Unresolved ("work_limit", DividingLines::work_limit says why), never an
 // exception; what the search certified before it stopped still decides the points it covers
-// (docs/design.md, "The JSON contract").
+// (docs/design.md, "The JSON contract").  The line's searches stop where the gap per unit θ̇m0
+// and its slope are certified to keep one sign up to the horizon (a nearly frictionless load:
+// horizons of 40·JL/FL; docs/design.md, "The event loop"): the same points, bit for bit, at
+// the cost of the motor's own time scale.
 #pragma once
 
 #include "backlash/numeric/validation.hpp"
