@@ -442,7 +442,7 @@ std::optional<Crossing> ClosedFormRun::separation(double theta0, double omega0, 
     if (auto t0 = certified_departure(contact_mode_, sample(0).x, 1e-12)) from = *t0;
   }
   while (!rigid_) {
-    separation = first_crossing(contact_mode_, sample, 0, from, remaining);
+    separation = detail::certified_first_crossing(contact_mode_, sample, 0, from, remaining);
     if (!separation || !separation->grazing) break;
     from = separation->t + 1e-12 * std::max(contact_mode_.time_unit, separation->t);
   }
@@ -504,9 +504,9 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   const auto at = [&flight](double tau) { return flight.at(tau); };
   const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(p_, state_.dtheta_m))});
   const auto sample = [&flight](double tau) { return flight.gap_sample(tau); };
-  const auto event = start_gap_ ? detail::first_gap_event_inside(gap_mode_, sample, *start_gap_, state_.face,
-                                                                 p_.backlash / 2, remaining)
-                                : detail::first_gap_event(gap_mode_, sample, -state_.face * p_.backlash, remaining, scale);
+  const auto event = start_gap_ ? detail::first_gap_event_inside_with(gap_mode_, sample, *start_gap_, state_.face,
+                                                                      p_.backlash / 2, remaining)
+                                : detail::first_gap_event_with(gap_mode_, sample, -state_.face * p_.backlash, remaining, scale);
   start_gap_.reset();  // every later flight leaves a face
   if (o_.track_extremes) {
     const auto vector = [&flight](double tau) { return flight.vector(tau); };
