@@ -8,15 +8,15 @@
 
 #include "backlash/numeric/first_crossing.hpp"
 
-#include <boost/container/small_vector.hpp>
-
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace backlash::numeric::detail {
 
@@ -58,22 +58,27 @@ inline double growth_bound(double x) {
 // expressions (bit for bit the same: a dot product of 4 sums the products pairwise,
 // (a0b0 + a2b2) + (a1b1 + a3b3); A x sums each row's products left to right, then adds c).
 template <int N>
-[[gnu::always_inline]] inline double dot_of(const SmallRow& r, const double* x) {
-  if constexpr (N == 4) return (r(0) * x[0] + r(2) * x[2]) + (r(1) * x[1] + r(3) * x[3]);
-  else return r(0) * x[0] + r(1) * x[1];
+[[gnu::always_inline]] inline double dot_of(const SmallRow& row, const double* x) {
+  const double* r = row.data();
+  if constexpr (N == 4) return (r[0] * x[0] + r[2] * x[2]) + (r[1] * x[1] + r[3] * x[3]);
+  else return r[0] * x[0] + r[1] * x[1];
 }
 
-// z = A x + c (x' at x) into z; returns ‖x‖∞.
+// z = A x + c (x' at x) into z; returns ‖x‖∞.  `A` column-major N × N (Eigen's storage).
 template <int N>
-[[gnu::always_inline]] inline double rate_of(const WitnessMode& m, const double* x, double* z) {
+[[gnu::always_inline]] inline double rate_of(const double* A, const double* c, const double* x, double* z) {
   double size = 0;
   for (int i = 0; i < N; ++i) {
-    double zi = m.A(i, 0) * x[0];
-    for (int j = 1; j < N; ++j) zi += m.A(i, j) * x[j];
-    z[i] = zi + m.c(i);
+    double zi = A[i] * x[0];
+    for (int j = 1; j < N; ++j) zi += A[i + N * j] * x[j];
+    z[i] = zi + c[i];
     size = std::max(size, std::fabs(x[i]));
   }
   return size;
+}
+template <int N>
+[[gnu::always_inline]] inline double rate_of(const WitnessMode& m, const double* x, double* z) {
+  return rate_of<N>(m.A.data(), m.c.data(), x, z);
 }
 
 // A witness on a mode, sampled through one closed-form evaluation per point: `sample(t)` (any
@@ -101,10 +106,11 @@ class Sampler {
   template <int N>
   Sample fixed_size(double t, double w, const double* x) const {
     double z[N];
-    const double size = rate_of<N>(m_, x, z);
+    const double size = rate_of<N>(m_.A.data(), m_.c.data(), x, z);
+    const double* scale = m_.scale.data();
     double rate = 0;
     for (int i = 0; i < N; ++i) {
-      const double scaled = std::fabs(z[i] * m_.scale(i));
+      const double scaled = std::fabs(z[i] * scale[i]);
       rate = i == 0 ? scaled : std::max(rate, scaled);
     }
     return {t, w, dot_of<N>(m_.eA, x) + m_.ec, dot_of<N>(m_.eA2, x) + m_.eAc, rate, size};
@@ -203,6 +209,29 @@ struct End {
 
 inline Sample lazy(double t) { return {t, 0, 0, 0, 0, 0}; }
 
+// The search's stack of right ends: 96 inline (a bisection 96 levels below a window), a heap
+// vector only beyond — no allocation and no out-of-line growth check per interval.
+class EndStack {
+ public:
+  bool empty() const { return size_ == 0; }
+  End& back() { return size_ <= kInline ? inline_[size_ - 1] : spill_.back(); }
+  void push_back(const End& end) {
+    if (size_ < kInline) inline_[size_] = end;
+    else spill_.push_back(end);
+    ++size_;
+  }
+  void pop_back() {
+    if (size_ > kInline) spill_.pop_back();
+    --size_;
+  }
+
+ private:
+  static constexpr std::size_t kInline = 96;
+  std::size_t size_ = 0;
+  End inline_[kInline];
+  std::vector<End> spill_;
+};
+
 // The root of w in [a, b]: a sign change, w monotone there (certified: the root is unique) or the
 // interval at the resolution.  Halley's iteration on the samples' w, w', w'' (one closed-form
 // evaluation per step), from the end nearer the root, kept inside the bracket (bisection when a
@@ -227,9 +256,13 @@ double root_in(const Sampler<F>& W, const Sample& a, const Sample& b, const Cros
     if (std::fabs(step) <= 0.25 * width) return s.t + step;
     const double next = s.t + step;
     if (next > lo && next < hi) {
+      // The test is monotone in K (each rounded operation is): when it fails on K's first term
+      // alone it fails on K, and sup|w'''| (its growth bound) is not needed.
+      const auto within = [step, width](double K) { return 2 * K * std::fabs(step) * step * step <= 0.25 * width; };
       const double curvature = 0.5 * s.w2 / s.w1;
-      const double K = curvature * curvature + W.third_bound(s, std::fabs(step)) / (6 * std::fabs(s.w1));
-      if (2 * K * std::fabs(step) * step * step <= 0.25 * width) return next;
+      if (within(curvature * curvature) &&
+          within(curvature * curvature + W.third_bound(s, std::fabs(step)) / (6 * std::fabs(s.w1))))
+        return next;
     } else {
       const double mid = 0.5 * (lo + hi);
       if (hi - lo <= width) return mid;
@@ -259,7 +292,7 @@ std::optional<Crossing> search(const Sampler<F>& W, const std::function<double(d
   if (!(t_end > t_begin)) return std::nullopt;
   const double min_length = options.min_interval * W.mode().time_unit;
   long examined = 0;
-  boost::container::small_vector<End, 96> ends;
+  EndStack ends;
   Sample a = W.at(t_begin);
   double window = W.mode().first_window;
   while (a.t < t_end) {
