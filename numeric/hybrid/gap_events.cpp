@@ -44,18 +44,6 @@ namespace {
 // grazing, two crossings closer than 1e-9 of their time, an exhausted budget — goes to the
 // sequential searches themselves.
 
-using SpanSearch = FunctionRef<std::optional<Crossing>(double, double)>;
-
-struct Level {
-  SpanSearch search;  ///< the certified first crossing in (lo, hi]; search(start, T) is the level's whole search
-  double start;       ///< no crossing on (0, start] (a departure certified clear up to there)
-};
-
-struct LevelEvent {
-  bool second;  ///< the second level crossed first
-  Crossing crossing;
-};
-
 // The reference's answer from the first level's whole search: the second searched up to its crossing.
 std::optional<LevelEvent> with_second(const std::optional<Crossing>& a, const Level& second, double horizon) {
   const std::optional<Crossing> b = second.search(second.start, a ? a->t : horizon);
@@ -170,6 +158,8 @@ std::optional<LevelEvent> windowed_levels(const Level& first, const Level& secon
   return sequential_search(first, second, horizon);
 }
 
+}  // namespace
+
 // The two levels, window by window when the mode has a time scale, else one after the other.
 std::optional<LevelEvent> first_of_two_levels(const Level& first, const Level& second, double horizon,
                                               double first_window, const long& samples) {
@@ -177,64 +167,15 @@ std::optional<LevelEvent> first_of_two_levels(const Level& first, const Level& s
   return windowed_levels(first, second, horizon, first_window, samples);
 }
 
-}  // namespace
 
 std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
                                         double opposite_face_change, double horizon, double position_scale) {
-  // x(0): the searches' first point and the departure's start, evaluated once.  The return search
-  // samples its horizon, the opposite face's crossing when it is searched up to one: that sample
-  // is kept as the event's state (`watch`: the horizon of the return search last started).
-  const WitnessSample start = sample(0);
-  long samples = 0;
-  double watch = -1;
-  SmallVector at_watch;
-  const auto counted = [&sample, &samples, &start, &watch, &at_watch](double t) {
-    ++samples;
-    if (t == 0) return start;
-    WitnessSample s = sample(t);
-    if (t == watch) at_watch = s.x;
-    return s;
-  };
-  const auto opposite = [&](double lo, double hi) { return first_crossing(gap_mode, counted, opposite_face_change, lo, hi); };
-  // Return to the face left: Δx starts as O(t²) or O(t³), below rounding noise at first.
-  const double noise = 1e-10 * std::max(1.0, position_scale);
-  const SmallVector& x0 = start.x;
-  const std::optional<double> t0 = certified_departure(gap_mode, x0, noise);
-  if (!t0) {
-    const std::optional<Crossing> only = first_crossing(gap_mode, counted, opposite_face_change, 0, horizon);
-    if (only) return GapEvent{GapEventKind::OppositeFace, *only, 0, false, {}};
-    return std::nullopt;
-  }
-  const double clear = certified_clearance(gap_mode, x0, *t0, noise);
-  const auto back = [&](double lo, double hi) {
-    watch = hi;
-    at_watch.resize(0);
-    return first_crossing_after_departure(gap_mode, counted, *t0, std::max(clear, lo), hi);
-  };
-  const Level first{opposite, 0}, second{back, clear > *t0 ? std::min(clear, horizon) : *t0};
-  const std::optional<LevelEvent> event = first_of_two_levels(first, second, horizon, gap_mode.first_window, samples);
-  if (!event) return std::nullopt;
-  if (event->second) return GapEvent{GapEventKind::FaceLeft, event->crossing, *t0, false, {}};
-  const bool sampled_there = watch == event->crossing.t && at_watch.size() > 0;
-  return GapEvent{GapEventKind::OppositeFace, event->crossing, 0, false, sampled_there ? at_watch : SmallVector{}};
+  return first_gap_event_with(gap_mode, sample, opposite_face_change, horizon, position_scale);
 }
 
 std::optional<GapEvent> first_gap_event_inside(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
                                                double start_gap, int face, double half, double horizon) {
-  long samples = 0;
-  const auto counted = [&sample, &samples](double t) {
-    ++samples;
-    return sample(t);
-  };
-  const auto same = [&](double lo, double hi) { return first_crossing(gap_mode, counted, face * half - start_gap, lo, hi); };
-  const auto opposite = [&](double lo, double hi) {
-    return first_crossing(gap_mode, counted, -face * half - start_gap, lo, hi);
-  };
-  const Level first{same, 0}, second{opposite, 0};
-  const std::optional<LevelEvent> event = first_of_two_levels(first, second, horizon, gap_mode.first_window, samples);
-  if (!event) return std::nullopt;
-  if (event->second) return GapEvent{GapEventKind::OppositeFace, event->crossing, 0, true, {}};
-  return GapEvent{GapEventKind::FaceLeft, event->crossing, 0, true, {}};
+  return first_gap_event_inside_with(gap_mode, sample, start_gap, face, half, horizon);
 }
 
 std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,

@@ -4,7 +4,9 @@
 
 #include "backlash/numeric/first_crossing.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
+#include "hybrid/certified_search.hpp"
 
+#include <algorithm>
 #include <functional>
 #include <optional>
 
@@ -45,6 +47,90 @@ std::optional<GapEvent> first_gap_event_inside(const WitnessMode& gap_mode, Func
                                                double start_gap, int face, double half, double horizon);
 
 /// The gap witness's mode: e = θL − θm on the free segment.
+WitnessMode gap_witness_mode(const LinearSegment& free_segment, double time_unit);
+
+// The two gap levels of a flight (gap_events.cpp): each level's certified search over a span,
+// the earlier crossing of the two kept.
+using SpanSearch = FunctionRef<std::optional<Crossing>(double, double)>;
+
+struct Level {
+  SpanSearch search;  ///< the certified first crossing in (lo, hi]; search(start, T) is the level's whole search
+  double start;       ///< no crossing on (0, start] (a departure certified clear up to there)
+};
+
+struct LevelEvent {
+  bool second;  ///< the second level crossed first
+  Crossing crossing;
+};
+
+/// The first crossing of either level within `horizon`, as the two searches one after the other
+/// find it (the first level over the horizon, the second up to its crossing), window by window
+/// when the mode has a time scale (`first_window`); `samples` counts the samples taken so far.
+std::optional<LevelEvent> first_of_two_levels(const Level& first, const Level& second, double horizon,
+                                              double first_window, const long& samples);
+
+/// first_gap_event on the gap mode with `sample` any callable (double) → WitnessSample: the
+/// event loop's own flight, called directly by the certified search (certified_search.hpp).
+template <class F>
+std::optional<GapEvent> first_gap_event_with(const WitnessMode& gap_mode, const F& sample, double opposite_face_change,
+                                             double horizon, double position_scale) {
+  // x(0): the searches' first point and the departure's start, evaluated once.  The return search
+  // samples its horizon, the opposite face's crossing when it is searched up to one: that sample
+  // is kept as the event's state (`watch`: the horizon of the return search last started).
+  const WitnessSample start = sample(0);
+  long samples = 0;
+  double watch = -1;
+  SmallVector at_watch;
+  const auto counted = [&sample, &samples, &start, &watch, &at_watch](double t) {
+    ++samples;
+    WitnessSample s = t == 0 ? start : sample(t);  // (one object: no copy of the sample on return)
+    if (t == watch) at_watch = s.x;
+    return s;
+  };
+  const auto opposite = [&](double lo, double hi) { return certified_first_crossing(gap_mode, counted, opposite_face_change, lo, hi); };
+  // Return to the face left: Δx starts as O(t²) or O(t³), below rounding noise at first.
+  const double noise = 1e-10 * std::max(1.0, position_scale);
+  const SmallVector& x0 = start.x;
+  const std::optional<double> t0 = certified_departure(gap_mode, x0, noise);
+  if (!t0) {
+    const std::optional<Crossing> only = certified_first_crossing(gap_mode, counted, opposite_face_change, 0, horizon);
+    if (only) return GapEvent{GapEventKind::OppositeFace, *only, 0, false, {}};
+    return std::nullopt;
+  }
+  const double clear = certified_clearance(gap_mode, x0, *t0, noise);
+  const auto back = [&](double lo, double hi) {
+    watch = hi;
+    at_watch.resize(0);
+    return certified_crossing_after_departure(gap_mode, counted, *t0, std::max(clear, lo), hi);
+  };
+  const Level first{opposite, 0}, second{back, clear > *t0 ? std::min(clear, horizon) : *t0};
+  const std::optional<LevelEvent> event = first_of_two_levels(first, second, horizon, gap_mode.first_window, samples);
+  if (!event) return std::nullopt;
+  if (event->second) return GapEvent{GapEventKind::FaceLeft, event->crossing, *t0, false, {}};
+  const bool sampled_there = watch == event->crossing.t && at_watch.size() > 0;
+  return GapEvent{GapEventKind::OppositeFace, event->crossing, 0, false, sampled_there ? at_watch : SmallVector{}};
+}
+
+/// first_gap_event_inside with `sample` any callable (double) → WitnessSample.
+template <class F>
+std::optional<GapEvent> first_gap_event_inside_with(const WitnessMode& gap_mode, const F& sample, double start_gap,
+                                                    int face, double half, double horizon) {
+  long samples = 0;
+  const auto counted = [&sample, &samples](double t) {
+    ++samples;
+    return sample(t);
+  };
+  const auto same = [&](double lo, double hi) { return certified_first_crossing(gap_mode, counted, face * half - start_gap, lo, hi); };
+  const auto opposite = [&](double lo, double hi) {
+    return certified_first_crossing(gap_mode, counted, -face * half - start_gap, lo, hi);
+  };
+  const Level first{same, 0}, second{opposite, 0};
+  const std::optional<LevelEvent> event = first_of_two_levels(first, second, horizon, gap_mode.first_window, samples);
+  if (!event) return std::nullopt;
+  if (event->second) return GapEvent{GapEventKind::OppositeFace, event->crossing, 0, true, {}};
+  return GapEvent{GapEventKind::FaceLeft, event->crossing, 0, true, {}};
+}
+
 WitnessMode gap_witness_mode(const LinearSegment& free_segment, double time_unit);
 
 }  // namespace backlash::numeric::detail

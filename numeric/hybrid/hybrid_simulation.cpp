@@ -174,13 +174,14 @@ class Flight {
   std::optional<LinearFlight> linear_;
 };
 
-// A velocity as the angle it sweeps in the servo's time unit √(J/K) (1 s for the thesis's cases):
-// the scale of a state's angles for rounding tolerances, whatever the gain.
-double swept_angle(const Parameters& p, double velocity) { return velocity * servo_time_unit(p); }
+// A velocity as the angle it sweeps in the servo's time unit √(J/K) (servo_time_unit, 1 s for the
+// thesis's cases; the run's modes keep it): the scale of a state's angles for rounding
+// tolerances, whatever the gain.
+double swept_angle(double time_unit, double velocity) { return velocity * time_unit; }
 
-bool on_separation_line(const ValidatedEvaluator& evaluator, double theta_o, double velocity) {
+bool on_separation_line(const ValidatedEvaluator& evaluator, double theta_o, double velocity, double time_unit) {
   const double line = evaluator.evaluator().separation_theta(velocity);
-  const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(evaluator.parameters(), velocity))});
+  const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(time_unit, velocity))});
   return std::fabs(theta_o - line) <= 1e-9 * scale;
 }
 
@@ -442,7 +443,7 @@ std::optional<Crossing> ClosedFormRun::separation(double theta0, double omega0, 
     if (auto t0 = certified_departure(contact_mode_, sample(0).x, 1e-12)) from = *t0;
   }
   while (!rigid_) {
-    separation = first_crossing(contact_mode_, sample, 0, from, remaining);
+    separation = detail::certified_first_crossing(contact_mode_, sample, 0, from, remaining);
     if (!separation || !separation->grazing) break;
     from = separation->t + 1e-12 * std::max(contact_mode_.time_unit, separation->t);
   }
@@ -499,14 +500,14 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   const double remaining = o_.t_end - t_;
   const double theta_o = measured(p_, state_);
   const bool from_line = std::fabs(state_.dtheta_m - state_.dtheta_L) <= 1e-12 * std::max(1.0, std::fabs(state_.dtheta_m)) &&
-                         on_separation_line(evaluator_, theta_o, state_.dtheta_m);
+                         on_separation_line(evaluator_, theta_o, state_.dtheta_m, gap_mode_.time_unit);
   const Flight flight = from_line ? Flight::from_separation_line(evaluator_, state_) : Flight::from_state(p_, state_);
   const auto at = [&flight](double tau) { return flight.at(tau); };
-  const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(p_, state_.dtheta_m))});
+  const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(gap_mode_.time_unit, state_.dtheta_m))});
   const auto sample = [&flight](double tau) { return flight.gap_sample(tau); };
-  const auto event = start_gap_ ? detail::first_gap_event_inside(gap_mode_, sample, *start_gap_, state_.face,
-                                                                 p_.backlash / 2, remaining)
-                                : detail::first_gap_event(gap_mode_, sample, -state_.face * p_.backlash, remaining, scale);
+  const auto event = start_gap_ ? detail::first_gap_event_inside_with(gap_mode_, sample, *start_gap_, state_.face,
+                                                                      p_.backlash / 2, remaining)
+                                : detail::first_gap_event_with(gap_mode_, sample, -state_.face * p_.backlash, remaining, scale);
   start_gap_.reset();  // every later flight leaves a face
   if (o_.track_extremes) {
     const auto vector = [&flight](double tau) { return flight.vector(tau); };
