@@ -73,6 +73,22 @@ double departure_time(const SmallMatrix& A, const SmallRow& e, const SmallVector
   return 0;
 }
 
+// r·x and |r|·|x| for the modes' sizes, unrolled with Eigen's own order of operations for a
+// dynamic dot product (pairwise for 4: (r0x0 + r2x2) + (r1x1 + r3x3)), so the same bits as
+// r.dot(x) without its loop; Eigen for other sizes.
+double dot(const SmallRow& r, const SmallVector& x) {
+  if (r.size() == 4 && x.size() == 4) return (r(0) * x(0) + r(2) * x(2)) + (r(1) * x(1) + r(3) * x(3));
+  if (r.size() == 2 && x.size() == 2) return r(0) * x(0) + r(1) * x(1);
+  return r.dot(x.transpose());
+}
+double abs_dot(const SmallRow& r, const SmallVector& x) {
+  const auto a = [](double v) { return std::fabs(v); };
+  if (r.size() == 4 && x.size() == 4)
+    return (a(r(0)) * a(x(0)) + a(r(2)) * a(x(2))) + (a(r(1)) * a(x(1)) + a(r(3)) * a(x(3)));
+  if (r.size() == 2 && x.size() == 2) return a(r(0)) * a(x(0)) + a(r(1)) * a(x(1));
+  return r.cwiseAbs().dot(x.cwiseAbs().transpose());
+}
+
 enum class StartKind { Inside, ExitNow, Never };
 struct Start {
   StartKind kind = StartKind::Inside;
@@ -96,11 +112,10 @@ Start classify_start(const ModeFlow& flow, const LinearWitness& lw, const Witnes
   const SmallMatrix& A = mode ? mode->A : lw.A;
   const SmallRow& e = mode ? mode->e : lw.e;
   std::array<double, 4> w{};
-  w[0] = e.dot(z0) - lw.level;
-  w[1] = e.dot(zdot);
+  w[0] = dot(e, z0) - lw.level;
+  w[1] = dot(e, zdot);
   constexpr double eps = std::numeric_limits<double>::epsilon();
-  const double tolerance = 64 * eps * (e.cwiseAbs().dot(z0.cwiseAbs().transpose()) + magnitude) +
-                           32 * e.cwiseAbs().dot(z0_noise.transpose()) +
+  const double tolerance = 64 * eps * (abs_dot(e, z0) + magnitude) + 32 * abs_dot(e, z0_noise) +
                            std::fabs(w[1]) * 4e-14 * std::max(1.0, std::fabs(t_global));
   if (w[0] > tolerance) return {StartKind::Inside, 0};
   if (w[0] < -tolerance) return {StartKind::ExitNow, 0};
@@ -258,7 +273,7 @@ class ExitSearch {
     if (!mode_) return first_crossing(lw_, from_, until);
     const auto sample = [this](double tau) {
       WitnessSample s{memo_.local(tau), 0};
-      s.value = mode_->e.dot(s.x);
+      s.value = dot(mode_->e, s.x);
       return s;
     };
     return first_crossing(*mode_, sample, lw_.level, from_, until);
