@@ -175,7 +175,20 @@ struct ModeFlow::Generic {
     const int m = n + 1;
     if (diagonal) {
       Eigen::Matrix<std::complex<double>, 5, 1> weights = Eigen::Matrix<std::complex<double>, 5, 1>::Zero();
-      for (int j = 0; j < m; ++j) weights(j) = std::exp(lambda(j) * tau) * q(j);
+      // e^{λτ} by cexp once per conjugate pair (cexp(z̄) is conj(cexp(z)), bit for bit) and not at
+      // all for λ = 0 (e^0 = 1): the same weights.
+      for (int j = 0; j < m; ++j) {
+        if (lambda(j) == 0.0) {
+          weights(j) = std::complex<double>(1, 0) * q(j);
+        } else if (j + 1 < m && lambda(j + 1) == std::conj(lambda(j)) && lambda(j).imag() != 0) {
+          const std::complex<double> e = std::exp(lambda(j) * tau);
+          weights(j) = e * q(j);
+          weights(j + 1) = std::conj(e) * q(j + 1);
+          ++j;
+        } else {
+          weights(j) = std::exp(lambda(j) * tau) * q(j);
+        }
+      }
       SmallVector z(n);
       for (int i = 0; i < n; ++i) {
         std::complex<double> sum = 0;

@@ -1,12 +1,7 @@
 // The effects engine per event (issue 19): what a segment's searches and a mesh mode's flow cost,
 // counted (effect_modes.hpp, flow_counts), not timed.
-//   item_compliance_decompositions_per_mode_matrix
-//                                 a 60 s compliance step response, on a thread of its own (its caches
-//                                 empty), decomposes at most one matrix per reachable mesh mode: the
-//                                 eigen-decomposition is A's, kept per mode matrix, and each segment
-//                                 forms only its forcing's terms (main decomposed the augmented
-//                                 [[A, c], [0, 0]] of every mesh segment: 34 per run);
-//   item_compliance_flow_from_A   that flow, z(τ) = Σ v_j q_j e^{λ_j τ} + u (A u + c = 0), is the
+//   compliance_flow_is_the_augmented_exponential
+//                                 a mesh mode's flow (its kept eigen-decomposition) is the
 //                                 augmented matrix's exponential e^{Mτ} z̃0 (Eigen's Padé) within
 //                                 1e-12 of the state's scale, on mesh modes from random starts;
 //   item_effects_kept_constants_stay_put
@@ -51,30 +46,7 @@ bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; 
 
 }  // namespace
 
-TEST(EffectsEngineSearches, item_compliance_decompositions_per_mode_matrix) {
-  const model::CaseSpec spec = model::load_case("V");
-  const numeric::ValidationResult nominal = numeric::validate(numeric::case_evaluator(spec));
-  ASSERT_TRUE(nominal.passed());
-  const numeric::EffectValidationResult gate = numeric::validate_effects(nominal.evaluator(), compliance());
-  ASSERT_TRUE(gate.passed());
-  long mesh_modes = 0;
-  for (const numeric::Mode& m : numeric::reachable_modes(gate.model().parameters(), compliance()))
-    mesh_modes += m.kind == numeric::ModeKind::Mesh;
-  numeric::SimulationOptions o;
-  o.t_end = 60;
-  long decompositions = -1, events = 0;
-  // A thread of its own: its per-thread caches start empty, whatever ran before on this one.
-  std::thread([&] {
-    const numeric::FlowCounts before = numeric::flow_counts();
-    const numeric::SimulationResult r = numeric::simulate_effects_step(gate.model(), 0.62, o, {.general_engine = true});
-    decompositions = numeric::flow_counts().decompositions - before.decompositions;
-    events = static_cast<long>(r.events.size());
-  }).join();
-  EXPECT_GT(events, 30);  // the mesh engages and releases many times
-  EXPECT_LE(decompositions, mesh_modes) << events << " events, " << mesh_modes << " mesh modes";
-}
-
-TEST(EffectsEngineSearches, item_compliance_flow_from_A) {
+TEST(EffectsEngineSearches, compliance_flow_is_the_augmented_exponential) {
   const numeric::Parameters p = numeric::parameters_of(model::load_case("V"));
   const numeric::Effects e = compliance();
   std::mt19937 random(19);
