@@ -27,6 +27,11 @@ double drive_at(const Parameters& p, const Effects& e, double theta_o, int regim
 
 }  // namespace
 
+FlowCounts& flow_counts() {
+  thread_local FlowCounts counts;
+  return counts;
+}
+
 std::string Mode::describe() const {
   std::ostringstream out;
   auto slip = [](int s) { return s > 0 ? "+" : s < 0 ? "-" : "stuck"; };
@@ -119,6 +124,7 @@ struct ModeFlow::Generic {
     thread_local std::size_t next = 0;
     for (const Decomposition& d : cache)
       if (d.m == m && d.M == M) return d;
+    ++flow_counts().decompositions;
     Decomposition d;
     d.M = M;
     d.m = m;
@@ -169,7 +175,20 @@ struct ModeFlow::Generic {
     const int m = n + 1;
     if (diagonal) {
       Eigen::Matrix<std::complex<double>, 5, 1> weights = Eigen::Matrix<std::complex<double>, 5, 1>::Zero();
-      for (int j = 0; j < m; ++j) weights(j) = std::exp(lambda(j) * tau) * q(j);
+      // e^{λτ} by cexp once per conjugate pair (cexp(z̄) is conj(cexp(z)), bit for bit) and not at
+      // all for λ = 0 (e^0 = 1): the same weights.
+      for (int j = 0; j < m; ++j) {
+        if (lambda(j) == 0.0) {
+          weights(j) = std::complex<double>(1, 0) * q(j);
+        } else if (j + 1 < m && lambda(j + 1) == std::conj(lambda(j)) && lambda(j).imag() != 0) {
+          const std::complex<double> e = std::exp(lambda(j) * tau);
+          weights(j) = e * q(j);
+          weights(j + 1) = std::conj(e) * q(j + 1);
+          ++j;
+        } else {
+          weights(j) = std::exp(lambda(j) * tau) * q(j);
+        }
+      }
       SmallVector z(n);
       for (int i = 0; i < n; ++i) {
         std::complex<double> sum = 0;
@@ -337,7 +356,25 @@ ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const H
   }
 }
 
+// The kernels of a free flight at x = −(Fm/Jm)τ, y = −(FL/JL)τ: all of coupled_kernels when the
+// motor is driven by the moving load, else only the nodes the motor and the load use (the same
+// bits: coupled_kernels forms e^x, φ1, φ2 of each node by phi_pair; the rest stay 0).
+CoupledKernels ModeFlow::free_kernels(double x, double y) const {
+  if (motor_form_ == 3) return coupled_kernels(x, y);
+  CoupledKernels k{0, 0, 0, 0, 0, 0, 0, 0, 0};
+  if (motor_form_ == 1) {
+    const PhiPair px = phi_pair(x);
+    k.exp_x = px.e, k.phi1_x = px.phi1, k.phi2_x = px.phi2;
+  }
+  if (mode_.slip_load != 0) {
+    const PhiPair py = phi_pair(y);
+    k.exp_y = py.e, k.phi1_y = py.phi1, k.phi2_y = py.phi2;
+  }
+  return k;
+}
+
 SmallVector ModeFlow::local(double tau) const {
+  ++flow_counts().evaluations;
   const Mode& m = mode_;
   if (generic_) return generic_->at(tau);
   if (m.kind == ModeKind::Contact) {
@@ -357,7 +394,7 @@ SmallVector ModeFlow::local(double tau) const {
   SmallVector z(4);
   const double vm0 = z0_(1), vL0 = z0_(3);
   const double y = -b_ * tau, x = -a_ * tau, t2 = tau * tau;
-  const CoupledKernels k = coupled_kernels(x, y);
+  const CoupledKernels k = free_kernels(x, y);
   if (m.slip_load == 0) {
     z(2) = 0;
     z(3) = 0;

@@ -38,6 +38,7 @@
 #pragma once
 
 #include "backlash/numeric/effects.hpp"
+#include "evaluators/phi_functions.hpp"
 #include "backlash/numeric/first_crossing.hpp"
 #include "backlash/numeric/mode.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
@@ -48,6 +49,15 @@
 #include <vector>
 
 namespace backlash::numeric {
+
+/// The closed-form evaluations (ModeFlow::local) and the eigen-decompositions of mesh matrices
+/// made on this thread so far: the units the engine's cost is counted in (tests/numeric/
+/// check_effects_engine_searches.cpp bounds them per event).
+struct FlowCounts {
+  long evaluations = 0;
+  long decompositions = 0;
+};
+FlowCounts& flow_counts();
 
 /// Every mode the model can enter (for the gate): kinds × faces × regimes × slips.
 std::vector<Mode> reachable_modes(const Parameters& p, const Effects& e);
@@ -119,6 +129,7 @@ class ModeFlow {
  private:
   struct Generic;
   std::function<double(double, double)> matrix_exponential_bound(const SmallRow& row, int order) const;
+  CoupledKernels free_kernels(double x, double y) const;
   Parameters p_;
   Effects e_;
   Mode mode_;

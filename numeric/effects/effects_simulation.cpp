@@ -46,11 +46,11 @@ double factorial(int n) { return n <= 1 ? 1.0 : n * factorial(n - 1); }
 // rounding noise is positive): the largest τ0 = horizon/2^i where the Taylor lower bound
 //   w(τ) ≥ w_K τ^K/K! − Σ_{j<K} |w_j| τ^j/j! − sup|w^{(K+1)}| τ^{K+1}/(K+1)!
 // is positive, sup|w^{(K+1)}| ≤ ‖e A^K‖₁ e^{‖A‖τ} ‖ż(0)‖∞.  0 when none is found.
-double departure_time(const LinearWitness& lw, const SmallVector& zdot0, const std::array<double, 4>& w, int K,
-                      double horizon) {
-  SmallRow eAK = lw.e;
-  for (int k = 0; k < K; ++k) eAK = eAK * lw.A;
-  const double norm_A = lw.A.cwiseAbs().rowwise().sum().maxCoeff(), norm_z = zdot0.cwiseAbs().maxCoeff();
+double departure_time(const SmallMatrix& A, const SmallRow& e, const SmallVector& zdot0, const std::array<double, 4>& w,
+                      int K, double horizon) {
+  SmallRow eAK = e;
+  for (int k = 0; k < K; ++k) eAK = eAK * A;
+  const double norm_A = A.cwiseAbs().rowwise().sum().maxCoeff(), norm_z = zdot0.cwiseAbs().maxCoeff();
   const double norm_eAK = eAK.cwiseAbs().sum();
   double tau = horizon;
   int i = 0;
@@ -73,6 +73,22 @@ double departure_time(const LinearWitness& lw, const SmallVector& zdot0, const s
   return 0;
 }
 
+// r·x and |r|·|x| for the modes' sizes, unrolled with Eigen's own order of operations for a
+// dynamic dot product (pairwise for 4: (r0x0 + r2x2) + (r1x1 + r3x3)), so the same bits as
+// r.dot(x) without its loop; Eigen for other sizes.
+double dot(const SmallRow& r, const SmallVector& x) {
+  if (r.size() == 4 && x.size() == 4) return (r(0) * x(0) + r(2) * x(2)) + (r(1) * x(1) + r(3) * x(3));
+  if (r.size() == 2 && x.size() == 2) return r(0) * x(0) + r(1) * x(1);
+  return r.dot(x.transpose());
+}
+double abs_dot(const SmallRow& r, const SmallVector& x) {
+  const auto a = [](double v) { return std::fabs(v); };
+  if (r.size() == 4 && x.size() == 4)
+    return (a(r(0)) * a(x(0)) + a(r(2)) * a(x(2))) + (a(r(1)) * a(x(1)) + a(r(3)) * a(x(3)));
+  if (r.size() == 2 && x.size() == 2) return a(r(0)) * a(x(0)) + a(r(1)) * a(x(1));
+  return r.cwiseAbs().dot(x.cwiseAbs().transpose());
+}
+
 enum class StartKind { Inside, ExitNow, Never };
 struct Start {
   StartKind kind = StartKind::Inside;
@@ -93,19 +109,20 @@ Start classify_start(const ModeFlow& flow, const LinearWitness& lw, const Witnes
                      double magnitude, double horizon, double t_global) {
   const SmallVector& z0 = flow.local_start();
   const SmallVector& z0_noise = flow.local_start_noise();
+  const SmallMatrix& A = mode ? mode->A : lw.A;
+  const SmallRow& e = mode ? mode->e : lw.e;
   std::array<double, 4> w{};
-  w[0] = lw.e.dot(z0) - lw.level;
-  w[1] = lw.e.dot(zdot);
+  w[0] = dot(e, z0) - lw.level;
+  w[1] = dot(e, zdot);
   constexpr double eps = std::numeric_limits<double>::epsilon();
-  const double tolerance = 64 * eps * (lw.e.cwiseAbs().dot(z0.cwiseAbs().transpose()) + magnitude) +
-                           32 * lw.e.cwiseAbs().dot(z0_noise.transpose()) +
+  const double tolerance = 64 * eps * (abs_dot(e, z0) + magnitude) + 32 * abs_dot(e, z0_noise) +
                            std::fabs(w[1]) * 4e-14 * std::max(1.0, std::fabs(t_global));
   if (w[0] > tolerance) return {StartKind::Inside, 0};
   if (w[0] < -tolerance) return {StartKind::ExitNow, 0};
-  const SmallVector zdot_scale = lw.A.cwiseAbs() * (z0.cwiseAbs() + z0_noise) + flow.forcing_magnitude();
-  const SmallRow eA = mode ? mode->eA : SmallRow(lw.e * lw.A);
-  const SmallRow eA2 = mode ? mode->eA2 : SmallRow(eA * lw.A);
-  const std::array<const SmallRow*, 4> rows{nullptr, &lw.e, &eA, &eA2};  // e A^{k−1} for w^{(k)}
+  const SmallVector zdot_scale = A.cwiseAbs() * (z0.cwiseAbs() + z0_noise) + flow.forcing_magnitude();
+  const SmallRow eA = mode ? mode->eA : SmallRow(e * A);
+  const SmallRow eA2 = mode ? mode->eA2 : SmallRow(eA * A);
+  const std::array<const SmallRow*, 4> rows{nullptr, &e, &eA, &eA2};  // e A^{k−1} for w^{(k)}
   std::array<double, 4> scale{};
   for (int k = 1; k <= 3; ++k) {
     if (k > 1) w[k] = rows[k]->dot(zdot);
@@ -114,7 +131,7 @@ Start classify_start(const ModeFlow& flow, const LinearWitness& lw, const Witnes
   for (int K = 1; K <= 3; ++K) {
     if (std::fabs(w[K]) <= 1e-9 * scale[K]) continue;
     if (w[K] < 0) return {StartKind::ExitNow, 0};
-    const double from = departure_time(lw, zdot, w, K, horizon);
+    const double from = departure_time(A, e, zdot, w, K, horizon);
     return {StartKind::Inside, from > 0 ? from : std::min(horizon, 1e-12 * std::max(1.0, horizon))};
   }
   return {StartKind::Never, 0};
@@ -138,26 +155,33 @@ bool spurious_separation(const Parameters& p, const ModeFlow& flow, double tau) 
 // folded in): WitnessMode::set_forcing; the others (eᵀA^k, the balancing, μ∞, the norms) come
 // from A and e alone.  Exact comparison of A and e.  Building the
 // constants per search was a third of a closed-form segment's cost (issue 19).  The entry kept
-// for (A, e) is given the forcing c and returned as it is (the caller copies it before the next call).
+// for (A, e) is given the forcing c and returned as it is.  The least recently used entry is the
+// one replaced, so an entry stays where it is (and keeps its forcing) for the next capacity − 1
+// calls on this thread: a segment's searches (a few witnesses) hold their entries by reference.
 const WitnessMode& detail::kept_witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e) {
   constexpr std::size_t capacity = 32;
-  thread_local std::vector<WitnessMode> cache = [] {
-    std::vector<WitnessMode> v;
+  struct Entry {
+    WitnessMode mode;
+    std::uint64_t used;
+  };
+  thread_local std::vector<Entry> cache = [] {
+    std::vector<Entry> v;
     v.reserve(capacity);
     return v;
   }();
-  thread_local std::size_t next = 0;
+  thread_local std::uint64_t clock = 0;
+  ++clock;
   const auto same = [](const auto& x, const auto& y) { return x.rows() == y.rows() && x.cols() == y.cols() && x == y; };
-  for (WitnessMode& m : cache) {
-    if (!same(m.e, e) || !same(m.A, A)) continue;
-    m.set_forcing(c);
-    return m;
+  for (Entry& entry : cache) {
+    if (!same(entry.mode.e, e) || !same(entry.mode.A, A)) continue;
+    entry.mode.set_forcing(c);
+    entry.used = clock;
+    return entry.mode;
   }
-  if (cache.size() < capacity) return cache.emplace_back(A, c, e);
-  cache[next] = WitnessMode(A, c, e);
-  const std::size_t at = next;
-  next = (next + 1) % capacity;
-  return cache[at];
+  if (cache.size() < capacity) return cache.push_back({WitnessMode(A, c, e), clock}), cache.back().mode;
+  Entry& oldest = *std::min_element(cache.begin(), cache.end(), [](const Entry& a, const Entry& b) { return a.used < b.used; });
+  oldest = {WitnessMode(A, c, e), clock};
+  return oldest.mode;
 }
 
 WitnessMode detail::witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e) {
@@ -174,11 +198,13 @@ namespace {
 class SampleMemo {
  public:
   explicit SampleMemo(const ModeFlow& flow) : flow_(flow) {}
-  SmallVector local(double tau) const {
+  const SmallVector& local(double tau) const {
     std::uint64_t key;
     std::memcpy(&key, &tau, sizeof key);
-    for (int i = 0; i < size_; ++i)
+    for (int k = 1, i = next_; k <= size_; ++k) {  // the newest first: most repeats are of the last few
+      i = i == 0 ? capacity - 1 : i - 1;
       if (keys_[i] == key) return z_[i];
+    }
     const int at = next_;
     next_ = (next_ + 1) % capacity;
     size_ = std::max(size_, next_ == 0 ? capacity : next_);
@@ -201,15 +227,20 @@ class ExitSearch {
   ExitSearch(const Parameters& p, const ModeFlow& flow, const SampleMemo& memo, const SmallVector& zdot,
              const Witness& witness, double horizon, double t_global)
       : p_(p), flow_(flow), memo_(memo), witness_(witness) {
-    lw_.A = flow.segment().A;
-    lw_.c = flow.segment().c;
-    lw_.e = witness.f.row;
     lw_.level = -witness.f.constant;
-    lw_.third_derivative_bound = flow.derivative_bound(lw_.e, 3);
-    // Without a stiff bound the search on a mode built once is the LinearWitness search, bit for bit.
-    if (!lw_.third_derivative_bound) mode_.emplace(detail::kept_witness_mode(lw_.A, lw_.c, lw_.e));
-    else lw_.state = [&memo](double tau) { return memo.local(tau); };
-    const Start start = classify_start(flow, lw_, mode_ ? &*mode_ : nullptr, zdot, witness.f.magnitude, horizon, t_global);
+    // Without a stiff bound the search on a mode built once (kept per thread: its entry stays put
+    // while this segment's searches run) is the LinearWitness search, bit for bit.
+    std::function<double(double, double)> bound = flow.derivative_bound(witness.f.row, 3);
+    if (!bound) {
+      mode_ = &detail::kept_witness_mode(flow.segment().A, flow.segment().c, witness.f.row);
+    } else {
+      lw_.A = flow.segment().A;
+      lw_.c = flow.segment().c;
+      lw_.e = witness.f.row;
+      lw_.third_derivative_bound = std::move(bound);
+      lw_.state = [&memo](double tau) { return memo.local(tau); };
+    }
+    const Start start = classify_start(flow, lw_, mode_, zdot, witness.f.magnitude, horizon, t_global);
     if (start.kind == StartKind::Never) finished_ = true;
     if (start.kind == StartKind::ExitNow) immediate_ = true;
     from_ = start.from;
@@ -242,7 +273,7 @@ class ExitSearch {
     if (!mode_) return first_crossing(lw_, from_, until);
     const auto sample = [this](double tau) {
       WitnessSample s{memo_.local(tau), 0};
-      s.value = lw_.e.dot(s.x);
+      s.value = dot(mode_->e, s.x);
       return s;
     };
     return first_crossing(*mode_, sample, lw_.level, from_, until);
@@ -252,7 +283,7 @@ class ExitSearch {
   const SampleMemo& memo_;
   Witness witness_;
   LinearWitness lw_;
-  std::optional<WitnessMode> mode_;  // the witness's constants, when the search needs no stiff bound
+  const WitnessMode* mode_ = nullptr;  // the witness's constants, when the search needs no stiff bound
   double from_ = 0;
   bool finished_ = false, immediate_ = false;
 };

@@ -106,9 +106,7 @@ void pair_series(double x, double y, double m, double& a1, double& a2) {
   }
 }
 
-struct PhiPair {
-  double e, phi1, phi2;
-};
+}  // namespace
 
 // e^x, φ1(x), φ2(x): one Horner series (φ1 = 1 + xφ2, e^x = 1 + xφ1) for
 // |x| < 1/8; else expm1 and φ2 = (φ1 − 1)/x, which loses at most a factor 16.
@@ -132,8 +130,6 @@ PhiPair phi_pair(double x) {
   const double phi1 = em1 / x;
   return {e, phi1, (phi1 - 1.0) / x};
 }
-
-}  // namespace
 
 ExpPhi1 exp_phi1(double x) {
   const PhiPair p = phi_pair(x);

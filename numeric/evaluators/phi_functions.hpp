@@ -45,6 +45,13 @@ double phi(int n, double x);
 /// exp[0^n, x, y]: the divided difference of exp over n zeros and x, y; n = 0…3.
 double exp_divided_difference(int n, double x, double y);
 
+/// e^x, φ1(x), φ2(x) with one libm call (coupled_kernels' own, bit for bit: a flow that needs
+/// only one node's kernels computes just those).
+struct PhiPair {
+  double e, phi1, phi2;
+};
+PhiPair phi_pair(double x);
+
 /// e^x and φ1(x) with one libm call.
 struct ExpPhi1 {
   double exp_x, phi1_x;

@@ -1,0 +1,126 @@
+// The effects engine per event (issue 19): what a segment's searches and a mesh mode's flow cost,
+// counted (effect_modes.hpp, flow_counts), not timed.
+//   compliance_flow_is_the_augmented_exponential
+//                                 a mesh mode's flow (its kept eigen-decomposition) is the
+//                                 augmented matrix's exponential e^{Mτ} z̃0 (Eigen's Padé) within
+//                                 1e-12 of the state's scale, on mesh modes from random starts;
+//   item_effects_kept_constants_stay_put
+//                                 a kept witness's constants stay where they are while they are in use:
+//                                 the cache replaces its least recently used entry, so an entry used
+//                                 again is not the next one overwritten (main's round robin replaced
+//                                 it), and it stays bit for bit WitnessMode(A, c, e);
+//   free_kernels_as_coupled       a free flight's kernels of one node (phi_pair) are coupled_kernels'
+//                                 own, bit for bit.
+#include "effects/effect_modes.hpp"
+#include "effects/effects_engine.hpp"
+#include "evaluators/phi_functions.hpp"
+
+#include "backlash/model/case_spec.hpp"
+#include "backlash/numeric/effects_simulation.hpp"
+#include "backlash/numeric/evaluator.hpp"
+#include "backlash/numeric/parametric.hpp"
+#include "backlash/numeric/validation.hpp"
+
+#include <gtest/gtest.h>
+#include <unsupported/Eigen/MatrixFunctions>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace {
+
+using namespace backlash;
+
+numeric::Effects compliance() {
+  numeric::Effects e;
+  e.mesh_stiffness = 400;
+  e.mesh_damping = 4;
+  return e;
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+}  // namespace
+
+TEST(EffectsEngineSearches, compliance_flow_is_the_augmented_exponential) {
+  const numeric::Parameters p = numeric::parameters_of(model::load_case("V"));
+  const numeric::Effects e = compliance();
+  std::mt19937 random(19);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  int checked = 0;
+  for (const numeric::Mode& m : numeric::reachable_modes(p, e)) {
+    if (m.kind != numeric::ModeKind::Mesh) continue;
+    for (int trial = 0; trial < 20; ++trial) {
+      numeric::HybridState start;
+      start.in_contact = true;
+      start.face = m.face;
+      start.theta_m = 0.6 + 0.3 * unit(random);
+      start.theta_L = start.theta_m + m.face * (p.backlash / 2 + 1e-3 * std::fabs(unit(random)));
+      start.dtheta_m = unit(random);
+      start.dtheta_L = unit(random);
+      const numeric::ModeFlow flow(p, e, m, start);
+      ASSERT_FALSE(flow.uses_matrix_exponential()) << m.describe();
+      const int n = static_cast<int>(flow.segment().A.rows());
+      Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n + 1, n + 1);
+      M.topLeftCorner(n, n) = flow.segment().A;
+      M.block(0, n, n, 1) = flow.segment().c;
+      Eigen::VectorXd z0(n + 1);
+      z0.head(n) = flow.local_start();
+      z0(n) = 1;
+      for (double tau : {1e-3, 0.05, 0.4, 2.0}) {
+        const Eigen::VectorXd reference = ((M * tau).exp() * z0).head(n);
+        const numeric::SmallVector z = flow.local(tau);
+        const double scale = std::max(1.0, reference.cwiseAbs().maxCoeff());
+        EXPECT_LE((z - reference).cwiseAbs().maxCoeff(), 1e-12 * scale) << m.describe() << ", tau " << tau;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GT(checked, 0);
+}
+
+TEST(EffectsEngineSearches, item_effects_kept_constants_stay_put) {
+  using numeric::SmallMatrix;
+  using numeric::SmallRow;
+  using numeric::SmallVector;
+  std::thread([] {
+    constexpr int capacity = 32;  // the cache's (effects_simulation.cpp)
+    std::mt19937 random(7);
+    std::uniform_real_distribution<double> entry(-2, 2);
+    const auto matrix = [&] {
+      SmallMatrix A(4, 4);
+      for (int i = 0; i < 16; ++i) A.data()[i] = entry(random);
+      return A;
+    };
+    SmallVector c(4);
+    c << 1, -2, 0.5, 3;
+    SmallRow e(4);
+    e << 1, 0, -1, 0;
+    std::vector<SmallMatrix> matrices;
+    for (int k = 0; k < capacity; ++k) matrices.push_back(matrix());
+    for (const SmallMatrix& A : matrices) numeric::detail::kept_witness_mode(A, c, e);
+    // The first entry used again, then a new matrix: the entry replaced is not the one just used.
+    const numeric::WitnessMode* used = &numeric::detail::kept_witness_mode(matrices[0], c, e);
+    numeric::detail::kept_witness_mode(matrix(), c, e);
+    const numeric::WitnessMode rebuilt(matrices[0], c, e);
+    EXPECT_TRUE(used->A == matrices[0] && used->e == e) << "the entry in use was replaced";
+    EXPECT_TRUE(same_bits(used->mu_A, rebuilt.mu_A) && same_bits(used->norm_eA2, rebuilt.norm_eA2) &&
+                same_bits(used->eA2c, rebuilt.eA2c));
+  }).join();
+}
+
+TEST(EffectsEngineSearches, free_kernels_as_coupled) {
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> exponent(-6, 2), sign(-1, 1);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const double x = -std::pow(10.0, exponent(random)), y = -std::pow(10.0, exponent(random)) * (sign(random) > 0.9 ? -1 : 1);
+    const numeric::CoupledKernels k = numeric::coupled_kernels(x, y);
+    const numeric::PhiPair px = numeric::phi_pair(x), py = numeric::phi_pair(y);
+    EXPECT_TRUE(same_bits(k.exp_x, px.e) && same_bits(k.phi1_x, px.phi1) && same_bits(k.phi2_x, px.phi2)) << x;
+    EXPECT_TRUE(same_bits(k.exp_y, py.e) && same_bits(k.phi1_y, py.phi1) && same_bits(k.phi2_y, py.phi2)) << y;
+  }
+}
