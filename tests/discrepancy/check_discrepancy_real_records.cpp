@@ -406,6 +406,7 @@ TEST(RealRecordsMatrix, the_confusion_matrix_over_real_kinds_of_record) {
     };
     if (const char* names = std::getenv("BACKLASH_MATRIX_CANDIDATES")) one_core.candidates = list(names);
     if (const char* names = std::getenv("BACKLASH_MATRIX_PARAMETERS")) one_core.parameters = list(names);
+    if (const char* work = std::getenv("BACKLASH_MATRIX_TOTAL_WORK")) one_core.total_work = std::atol(work);  // a budget tried
     const measurements::MeasuredRecord record = generated_data::generate_record(record_of(truth, condition, seed++));
     if (const char* folder = std::getenv("BACKLASH_MATRIX_RECORDS")) {  // each record as a CSV (to compare two builds' answers)
       char name[32];
