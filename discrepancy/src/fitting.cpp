@@ -38,12 +38,13 @@ void Simulator::prepare(const std::vector<ModelPoint>& points) {
 
 namespace {
 
-/// A model point and a length as bytes: the key of a kept simulation.
-std::string key_of(const ModelPoint& m, std::size_t samples) {
+/// A model point, a length and a grid as bytes: the key of a kept simulation.
+std::string key_of(const ModelPoint& m, std::size_t samples, Simulator::Grid grid) {
   const double p[] = {m.p.Jm, m.p.Fm, m.p.JL, m.p.FL, m.p.K, m.p.theta_R, m.p.backlash,
                       static_cast<double>(m.p.measured_at), static_cast<double>(samples)};
   std::string key(reinterpret_cast<const char*>(p), sizeof p);
   key.append(reinterpret_cast<const char*>(&m.e), sizeof m.e);  // Effects: doubles only
+  key.push_back(grid == Simulator::Grid::all ? 'a' : 'f');
   return key;
 }
 
@@ -51,16 +52,16 @@ constexpr std::size_t kKeptSimulations = 256;
 
 }  // namespace
 
-std::optional<Simulator::Kept> Simulator::recall(const std::string& key) {
+std::shared_ptr<const Simulator::Kept> Simulator::recall(const std::string& key) {
   std::lock_guard<std::mutex> lock(cache_mutex_);
   const auto found = cache_.find(key);
-  if (found == cache_.end()) return std::nullopt;
-  return *found->second;
+  if (found == cache_.end()) return nullptr;
+  return found->second;
 }
 
-void Simulator::keep(const std::string& key, const Kept& kept) {
+void Simulator::keep(const std::string& key, std::shared_ptr<const Kept> kept) {
   std::lock_guard<std::mutex> lock(cache_mutex_);
-  if (!cache_.emplace(key, std::make_shared<const Kept>(kept)).second) return;
+  if (!cache_.emplace(key, std::move(kept)).second) return;
   cache_order_.push_back(key);
   if (cache_order_.size() > kKeptSimulations) {
     cache_.erase(cache_order_.front());
@@ -68,59 +69,80 @@ void Simulator::keep(const std::string& key, const Kept& kept) {
   }
 }
 
+std::vector<std::size_t> Simulator::rows(std::size_t samples, Grid grid) const {
+  std::vector<std::size_t> out;
+  if (grid == Grid::fitted) {
+    const std::vector<std::size_t>& fitted = data_.fit_indices;
+    out.assign(fitted.begin(), std::lower_bound(fitted.begin(), fitted.end(), samples - 1));
+  }
+  if (grid == Grid::all || out.size() + 1 == samples) {  // every sample below the last: the whole grid
+    out.resize(samples);
+    std::iota(out.begin(), out.end(), std::size_t{0});
+    return out;
+  }
+  out.push_back(samples - 1);  // the last: where the simulation ends, and a failure before it shows
+  return out;
+}
+
 // A model point simulated before at this length is not simulated again (a fit's bracket, a
 // refit from the same point, a candidate judged after its fit): its work is charged all the same,
-// so the budget — a count — does not depend on which thread simulated it first.
-std::optional<std::vector<std::vector<double>>> Simulator::traces(const ModelPoint& m, std::size_t samples,
-                                                                  std::vector<numeric::SimulationEvent>* events, long* cost) {
+// so the budget — a count — does not depend on which thread simulated it first.  A fit's request
+// (Grid::fitted) is served by a simulation of the whole grid as well.
+Simulator::Traces Simulator::traces(const ModelPoint& m, std::size_t samples, std::vector<numeric::SimulationEvent>* events,
+                                    long* cost, Grid grid) {
   samples = std::min(samples, data_.size());
-  const std::string key = key_of(m, samples);
-  std::optional<Kept> kept = recall(key);
+  const std::vector<std::size_t> sampled = rows(samples, grid);
+  if (sampled.size() == samples) grid = Grid::all;
+  std::shared_ptr<const Kept> kept = recall(key_of(m, samples, Grid::all));
+  if (!kept && grid == Grid::fitted) kept = recall(key_of(m, samples, grid));
   if (kept) {
     ++simulations_, ++hits_;
     work_ += kept->cost;
   } else {
-    kept.emplace();
-    kept->traces = simulate(m, samples, &kept->events, &kept->cost);
-    if (kept->cost > 0) keep(key, *kept);
+    auto fresh = std::make_shared<Kept>();
+    fresh->traces = simulate(m, samples, sampled, &fresh->events, &fresh->cost);
+    if (fresh->cost > 0) keep(key_of(m, samples, grid), fresh);
+    kept = std::move(fresh);
   }
   if (events) *events = kept->events;
   if (cost) *cost = kept->cost;
   return kept->traces;
 }
 
-std::optional<std::vector<std::vector<double>>> Simulator::simulate(const ModelPoint& m, std::size_t samples,
-                                                                    std::vector<numeric::SimulationEvent>* events, long* cost) {
+Simulator::Traces Simulator::simulate(const ModelPoint& m, std::size_t samples, const std::vector<std::size_t>& rows,
+                                      std::vector<numeric::SimulationEvent>* events, long* cost) {
   std::optional<numeric::ValidatedEffectModel> model = family_.at(m.p, m.e);
   if (!model) {
     prepare({m});
     model = family_.at(m.p, m.e);
-    if (!model) return std::nullopt;
+    if (!model) return nullptr;
   }
   numeric::SimulationOptions o;
-  o.sample_times.assign(data_.t.begin(), data_.t.begin() + static_cast<std::ptrdiff_t>(samples));
-  for (double& time : o.sample_times) time -= step_time_;  // the model's clock starts at the step
+  o.sample_times.resize(rows.size());
+  for (std::size_t k = 0; k < rows.size(); ++k) o.sample_times[k] = data_.t[rows[k]] - step_time_;  // the model's clock starts at the step
   o.t_end = std::min(t_end_ - step_time_, o.sample_times.back()) + 1e-9;
   o.max_events = 20000;  // a fit's trial point that needs more (a stiff, barely damped mesh) is a failed point
   // The samples go straight into the traces (no list of full trajectory samples: on a long
-  // record that list was most of the workflow's memory, per worker thread).
-  std::vector<std::vector<double>> out(data_.which.size(), std::vector<double>(samples));
+  // record that list was most of the workflow's memory, per worker thread); the rows not sampled
+  // stay NaN.
+  auto out = std::make_shared<std::vector<std::vector<double>>>(data_.which.size(), std::vector<double>(samples, NAN));
   std::size_t filled = 0;
   auto keep = [&](const numeric::TrajectorySample& s) {
-    if (filled < samples)
+    if (filled < rows.size())
       for (std::size_t c = 0; c < data_.which.size(); ++c)
-        out[c][filled] = data_.which[c] == 0 ? s.theta_o : data_.which[c] == 1 ? s.theta_m : s.theta_L;
+        (*out)[c][rows[filled]] = data_.which[c] == 0 ? s.theta_o : data_.which[c] == 1 ? s.theta_m : s.theta_L;
     ++filled;
   };
   o.sample_sink = keep;
   ++simulations_;
+  samples_ += static_cast<long>(rows.size());
   numeric::SimulationResult r;
   const auto started = std::chrono::steady_clock::now();
   try {
     r = numeric::simulate_effects_step(*model, step_, o, {.general_engine = true});
   } catch (const std::exception& error) {  // a point the simulation cannot resolve: no trace there
     if (std::getenv("BACKLASH_DEBUG_FITS")) std::fprintf(stderr, "discrepancy: simulation failed (%s): %s\n", m.e.describe().c_str(), error.what());
-    return std::nullopt;
+    return nullptr;
   }
   *cost = this->cost(m, r.events.size());
   if (std::getenv("BACKLASH_DEBUG_COST"))  // calibrating the cost: work against the clock
@@ -132,8 +154,8 @@ std::optional<std::vector<std::vector<double>>> Simulator::simulate(const ModelP
   *events = r.events;
   for (numeric::SimulationEvent& event : *events) event.t += step_time_;  // on the record's clock
   if (r.status == numeric::SimulationStatus::NonFinite || r.status == numeric::SimulationStatus::EventLimit ||
-      r.status == numeric::SimulationStatus::Chattering || filled != samples)
-    return std::nullopt;
+      r.status == numeric::SimulationStatus::Chattering || filled != rows.size())
+    return nullptr;
   return out;
 }
 
@@ -175,10 +197,9 @@ double sum_of_squares(const std::vector<double>& r) {
 }
 
 namespace {
-double huber_rho(double r, double scale) {
+double huber_rho(const ceres::HuberLoss& loss, double r) {
   // ceres::HuberLoss's ρ(s) of s = r²: s inside the scale a, 2a|r| − a² beyond (at a = 3, a
   // residual of 20σ counts 111 instead of 400).
-  const ceres::HuberLoss loss(kHuberScale * scale);
   double rho[3];
   loss.Evaluate(r * r, rho);
   return rho[0];
@@ -186,8 +207,9 @@ double huber_rho(double r, double scale) {
 }  // namespace
 
 double robust_sum(const std::vector<double>& r, double scale) {
+  const ceres::HuberLoss loss(kHuberScale * scale);
   double sum = 0;
-  for (double x : r) sum += huber_rho(x, scale);
+  for (double x : r) sum += huber_rho(loss, x);
   return sum;
 }
 
@@ -223,6 +245,7 @@ struct Objective {
   std::atomic<long>& weighted;  ///< its cost as the search counts it (Simulator::cost): at most 4 budgets
   long budget;              ///< past it, no further simulation (deterministic, unlike a clock)
   double loss_scale = 1;    ///< the robust loss's scale, in σ (residual_scale() at the fit's start)
+  Simulator::Grid grid = Simulator::Grid::all;  ///< fitted: `indices` are fit_indices (the rest not simulated)
 
   ModelPoint point(const double* u) const {
     std::vector<double> values;
@@ -234,7 +257,7 @@ struct Objective {
     ++calls;
     std::vector<numeric::SimulationEvent> events;
     long cost = 0;
-    const auto traces = simulator.traces(point(u), indices.back() + 1, &events, &cost);
+    const auto traces = simulator.traces(point(u), indices.back() + 1, &events, &cost, grid);
     work += 1000 + static_cast<long>(events.size());
     weighted += cost;
     if (!traces) return std::nullopt;
@@ -251,8 +274,8 @@ struct CostFunctor {
     // Each residual through Huber's ρ on its own (sgn r·√ρ(r²)): the sum of squares Ceres
     // minimises is robust_sum().  (A loss function on the residual block would act on the
     // block's whole squared norm, Σ r², and robustify nothing.)
-    const double scale = objective->loss_scale;
-    std::transform(r->begin(), r->end(), out, [scale](double x) { return std::copysign(std::sqrt(huber_rho(x, scale)), x); });
+    const ceres::HuberLoss loss(kHuberScale * objective->loss_scale);
+    std::transform(r->begin(), r->end(), out, [&loss](double x) { return std::copysign(std::sqrt(huber_rho(loss, x)), x); });
     return true;
   }
 };
@@ -392,14 +415,15 @@ namespace {
 // cannot be simulated).
 double starting_residual_scale(Simulator& simulator, const Observations& data, const ModelPoint& base,
                                const EffectCandidate& c, const std::vector<double>* start_u,
-                               const std::vector<std::size_t>& samples) {
+                               const std::vector<std::size_t>& samples, Simulator::Grid grid) {
   ModelPoint from = base;
   if (start_u) {
     std::vector<double> values;
     for (std::size_t i = 0; i < c.ranges.size(); ++i) values.push_back(c.ranges[i].value((*start_u)[i]));
     from = c.apply(base, values);
   }
-  if (const auto traces = simulator.traces(from, samples.back() + 1)) return residual_scale(residuals(data, *traces, samples));
+  if (const auto traces = simulator.traces(from, samples.back() + 1, nullptr, nullptr, grid))
+    return residual_scale(residuals(data, *traces, samples));
   return 1;
 }
 
@@ -417,13 +441,14 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
   std::atomic<int> calls{0};
   std::atomic<long> work{0}, weighted{0};
   const std::vector<std::size_t>& samples = whole_record ? data.all_indices : data.fit_indices;
+  const Simulator::Grid grid = whole_record ? Simulator::Grid::all : Simulator::Grid::fitted;
   const std::size_t k = c.ranges.size();
   prepare_candidate(simulator, c, base);
   // The robust loss's scale: Huber's at kHuberScale times the scale of the residual where the fit
   // starts (its start, or the base model) — an M-estimate with a preliminary scale: at the noise
   // level the noise's σ (a spike is an outlier), over a systematic gap the gap's size (a gap the
   // model does not yet explain is no outlier: the fit then minimises the sum of squares its score is).
-  const double loss_scale = starting_residual_scale(simulator, data, base, c, start_u, samples);
+  const double loss_scale = starting_residual_scale(simulator, data, base, c, start_u, samples, grid);
   // The horizons: from a quarter servo period past where the base model first leaves the noise
   // band (the first events that tell the parameter apart), growing by half each stage.
   const double t0 = data.t.front(), t_end = data.t.back();
@@ -440,7 +465,7 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
     starts.push_back(*start_u);
   } else {
     const std::vector<std::size_t> first_samples = prefix(data, samples, horizons.front());
-    starts = scan_starts(Objective{simulator, data, base, c, first_samples, calls, work, weighted, budget, loss_scale}, c);
+    starts = scan_starts(Objective{simulator, data, base, c, first_samples, calls, work, weighted, budget, loss_scale, grid}, c);
   }
   // One parameter: the best two distinct valleys are followed from stage to stage (a valley
   // that looks best on a short horizon can lose on a longer one).
@@ -448,7 +473,7 @@ Fit fit_candidate(Simulator& simulator, const Observations& data, const ModelPoi
   double cell = start_u && !grow_from_start ? 0.02 : 1.0 / 39;  // one parameter: Brent's bracket, narrowing as the horizon grows
   for (std::size_t stage = 0; stage < horizons.size(); ++stage, cell = std::max(0.004, 0.6 * cell)) {
     const std::vector<std::size_t> stage_samples = prefix(data, samples, horizons[stage]);
-    const Objective objective{simulator, data, base, c, stage_samples, calls, work, weighted, budget, loss_scale};
+    const Objective objective{simulator, data, base, c, stage_samples, calls, work, weighted, budget, loss_scale, grid};
     std::vector<Solved> found;
     for (const std::vector<double>& u : starts) {
       Solved s = k == 1 ? brent(objective, u[0], cell) : solve(objective, u, false, 25);

@@ -73,6 +73,13 @@ struct Observations {
 /// Simulations of model points on the record's grid, through a validated family.
 class Simulator {
  public:
+  /// A simulation's traces: one column per observed column, each of the record's length asked for.
+  using Traces = std::shared_ptr<const std::vector<std::vector<double>>>;
+  /// Which samples a simulation computes: every one, or only those a fit reads (the fitted
+  /// samples below the length asked for, and the last one — the held-out samples are left NaN).
+  /// A sample is the model's state at its time whatever the others are (the engine's segments do
+  /// not depend on the sample times), so both give the same bits where both have a sample.
+  enum class Grid { all, fitted };
   /// `step_time`: the step's time on the record's clock ([experiment] step_time): the model,
   /// which starts with its step at 0, is sampled at t − step_time, its events reported at
   /// their time + step_time.
@@ -80,9 +87,10 @@ class Simulator {
   /// θ at the record's times for each observed column; nothing if the model is outside the
   /// validated family or the simulation did not end in a normal status.
   /// `cost`, if given, receives the simulation's work (cost()).
-  std::optional<std::vector<std::vector<double>>> traces(const ModelPoint& m, std::size_t samples,
-                                                         std::vector<numeric::SimulationEvent>* events = nullptr,
-                                                         long* cost = nullptr);
+  /// `grid`: Grid::fitted computes only the samples a fit reads (Observations::fit_indices); a
+  /// simulation kept on the whole grid serves it too.
+  Traces traces(const ModelPoint& m, std::size_t samples, std::vector<numeric::SimulationEvent>* events = nullptr,
+                long* cost = nullptr, Grid grid = Grid::all);
   /// Validates the family at these model points (a candidate's range corners).
   void prepare(const std::vector<ModelPoint>& points);
   int simulations() const { return simulations_.load(); }
@@ -96,18 +104,22 @@ class Simulator {
   void set_budget(long budget) { budget_ = budget; }
   bool budget_reached() const { return work_.load() >= budget_; }
   int cache_hits() const { return hits_.load(); }
+  /// The samples computed by every simulation so far (a kept simulation computes none).
+  long samples_computed() const { return samples_.load(); }
 
  private:
   /// A simulation kept: the traces (empty: it failed), its events and its cost.
   struct Kept {
-    std::optional<std::vector<std::vector<double>>> traces;
+    Traces traces;
     std::vector<numeric::SimulationEvent> events;
     long cost = 0;
   };
-  std::optional<Kept> recall(const std::string& key);
-  std::optional<std::vector<std::vector<double>>> simulate(const ModelPoint& m, std::size_t samples,
-                                                           std::vector<numeric::SimulationEvent>* events, long* cost);
-  void keep(const std::string& key, const Kept& kept);
+  std::shared_ptr<const Kept> recall(const std::string& key);
+  /// The record's rows a simulation of this length on this grid samples (ascending).
+  std::vector<std::size_t> rows(std::size_t samples, Grid grid) const;
+  Traces simulate(const ModelPoint& m, std::size_t samples, const std::vector<std::size_t>& rows,
+                  std::vector<numeric::SimulationEvent>* events, long* cost);
+  void keep(const std::string& key, std::shared_ptr<const Kept> kept);
   std::mutex cache_mutex_;
   std::map<std::string, std::shared_ptr<const Kept>> cache_;  ///< the last simulations, by model point and length
   std::vector<std::string> cache_order_;                    ///< oldest first
@@ -117,6 +129,7 @@ class Simulator {
   numeric::ValidatedModelFamily family_;
   std::atomic<int> simulations_{0};
   std::atomic<long> work_{0};
+  std::atomic<long> samples_{0};
   long budget_ = std::numeric_limits<long>::max();
 };
 

@@ -198,7 +198,7 @@ Eigen::MatrixXd directions(Search& s, const EffectCandidate& c, const ModelPoint
     for (const std::vector<double>* at : {&plus, &minus}) {
       std::vector<double> values;
       for (std::size_t i = 0; i < at->size(); ++i) values.push_back(c.ranges[i].value((*at)[i]));
-      const auto traces = s.simulator.traces(c.apply(base, values), s.o.size());
+      const auto traces = s.simulator.traces(c.apply(base, values), s.o.size(), nullptr, nullptr, Simulator::Grid::fitted);
       if (!traces) return {};
       r.push_back(residuals(s.o, *traces, s.o.fit_indices));
     }
@@ -245,7 +245,7 @@ double best_scan_point(Search& s, const EffectCandidate& c, const ModelPoint& at
     std::vector<double> values;
     for (std::size_t k = 0; k < u.size(); ++k) values.push_back(c.ranges[k].value(u[k]));
     long cost = 0;
-    const auto traces = s.simulator.traces(c.apply(at, values), s.o.size(), nullptr, &cost);
+    const auto traces = s.simulator.traces(c.apply(at, values), s.o.size(), nullptr, &cost, Simulator::Grid::fitted);
     work += cost;
     if (!traces) continue;
     std::vector<double> r = residuals(s.o, *traces, s.o.fit_indices);
@@ -668,7 +668,7 @@ std::string swap_correction(Search& s, const std::vector<std::string>& remaining
     for (std::size_t r = 0; r < std::min(kSwaps, ranked.size()); ++r) {
       const std::string& name = ranked[r].second.first;
       auto swapped = swapped_for(s, i, name, ranked[r].second.second);
-      const auto traces = swapped ? s.simulator.traces(swapped->second, s.o.size()) : std::nullopt;
+      const auto traces = swapped ? s.simulator.traces(swapped->second, s.o.size()) : nullptr;
       if (!traces) continue;
       const Scores scores = score(s.o, *traces);
       const double delta = scores.bic(k) - s.scores.bic(k);
@@ -710,7 +710,7 @@ std::vector<Parameter> refinement_start(Search& s, std::size_t i, const EffectCa
     for (int b = 0; b < kRefineCells; ++b) {
       const std::vector<double> values{c.ranges[0].value((a + 0.5) / kRefineCells), kinetic.value(u1),
                                        c.ranges[2].value((b + 0.5) / kRefineCells)};
-      const auto traces = s.simulator.traces(c.apply(at, values), s.o.size());
+      const auto traces = s.simulator.traces(c.apply(at, values), s.o.size(), nullptr, nullptr, Simulator::Grid::fitted);
       if (!traces) continue;
       std::vector<double> r = residuals(s.o, *traces, s.o.fit_indices);
       double sse = sum_of_squares(r);
@@ -744,7 +744,7 @@ bool refine_friction(Search& s, std::vector<std::string>& refinements, std::vect
     y.result.effect = name;
     Candidate& r = refined[i].result;
     std::optional<ModelPoint> point;
-    std::optional<std::vector<std::vector<double>>> traces;
+    Simulator::Traces traces;
     if (s.current.e.delay > 0) r.failure = "refining " + coulomb + ": the delayed model has no Stribeck friction";
     else try {
         r.parameters = refinement_start(s, i, y.candidate);

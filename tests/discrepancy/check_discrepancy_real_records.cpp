@@ -406,7 +406,14 @@ TEST(RealRecordsMatrix, the_confusion_matrix_over_real_kinds_of_record) {
     };
     if (const char* names = std::getenv("BACKLASH_MATRIX_CANDIDATES")) one_core.candidates = list(names);
     if (const char* names = std::getenv("BACKLASH_MATRIX_PARAMETERS")) one_core.parameters = list(names);
-    const Said s = run(case_v(), generated_data::generate_record(record_of(truth, condition, seed++)), one_core);
+    if (const char* work = std::getenv("BACKLASH_MATRIX_TOTAL_WORK")) one_core.total_work = std::atol(work);  // a budget tried
+    const measurements::MeasuredRecord record = generated_data::generate_record(record_of(truth, condition, seed++));
+    if (const char* folder = std::getenv("BACKLASH_MATRIX_RECORDS")) {  // each record as a CSV (to compare two builds' answers)
+      char name[32];
+      std::snprintf(name, sizeof name, "/%02d.csv", index - 1);
+      std::ofstream(std::string(folder) + name) << measurements::format_measured_csv(record);
+    }
+    const Said s = run(case_v(), record, one_core);
     std::string kind = truth.outside ? "outside the vocabulary"
                        : truth.named.empty() && truth.corrections.empty() ? "clean (" + condition.label + ")"
                        : truth.named.size() == 2                          ? "two effects"
