@@ -6,6 +6,7 @@
 #include "backlash/numeric/segment_dynamics.hpp"
 #include "hybrid/gap_events.hpp"
 #include "hybrid/rest_search.hpp"
+#include "hybrid/run_constants.hpp"
 #include "hybrid/sample_band.hpp"
 
 #include <boost/math/tools/roots.hpp>
@@ -184,13 +185,6 @@ bool on_separation_line(const ValidatedEvaluator& evaluator, double theta_o, dou
   return std::fabs(theta_o - line) <= 1e-9 * scale;
 }
 
-// The witness of one velocity (row of x) on a segment: its zeros are the extremes of the angle.
-WitnessMode velocity_mode(const LinearSegment& segment, Eigen::Index row, double time_unit) {
-  SmallRow e = SmallRow::Zero(segment.A.rows());
-  e(row) = 1;
-  return WitnessMode(segment.A, segment.c, e, time_unit);
-}
-
 // Extremes of a segment on [0, duration]: its end states and the certified zeros of the
 // velocities whose witnesses are `velocity_modes` (θ̇m and θ̇L; in contact both are θ̇o).
 // `vector(τ)` is the segment's state x, x' = A x + c.
@@ -302,25 +296,14 @@ class ClosedFormRun {
         p_(evaluator.parameters()),
         o_(options),
         recorder_(p_, options, result_),
-        contact_segment_(contact_mode_segment(p_)),
-        free_segment_(free_mode_segment(p_)),
-        torque_(transmitted_torque(p_)),
-        contact_mode_(contact_segment_.A, contact_segment_.c, torque_.r, servo_time_unit(p_)),
-        gap_mode_(detail::gap_witness_mode(free_segment_, servo_time_unit(p_))),
+        constants_(detail::run_constants(p_)),
         cancellation_scale_(4096 * std::numeric_limits<double>::epsilon() * std::fabs(torque_.r(0)) *
                             std::max(1.0, std::fabs(p_.theta_R))),
         rigid_(p_.backlash <= 0),  // a rigid drive: contact for ever, no events
         zeno_window_(zeno_window(p_, o_)),
         state_(rigid_ ? rigid_start(p_, start) : start),
         start_gap_(rigid_ || start.in_contact ? std::nullopt : start_gap),
-        band_(band) {
-    if (o_.track_extremes) {
-      const double unit = servo_time_unit(p_);
-      contact_velocity_.emplace(velocity_mode(contact_segment_, 1, unit));
-      free_velocities_.emplace(
-          std::array<WitnessMode, 2>{velocity_mode(free_segment_, 1, unit), velocity_mode(free_segment_, 3, unit)});
-    }
-  }
+        band_(band) {}
 
   SimulationResult run() {
     try {
@@ -381,13 +364,12 @@ class ClosedFormRun {
   const SimulationOptions& o_;
   SimulationResult result_;
   TrajectoryRecorder recorder_;
-  const LinearSegment contact_segment_, free_segment_;
-  const TransmittedTorque torque_;
-  // The witnesses' constants, once per run (mode and parameter set): Tc in contact, the gap in flight,
-  // and (track_extremes) the velocities.
-  const WitnessMode contact_mode_, gap_mode_;
-  std::optional<WitnessMode> contact_velocity_;
-  std::optional<std::array<WitnessMode, 2>> free_velocities_;
+  // The witnesses' constants, once per thread and parameter set (run_constants.hpp):
+  // Tc in contact, the gap in flight, and (track_extremes) the velocities.
+  const std::shared_ptr<const detail::RunConstants> constants_;
+  const TransmittedTorque& torque_ = constants_->torque;
+  const WitnessMode& contact_mode_ = constants_->contact_mode;
+  const WitnessMode& gap_mode_ = constants_->gap_mode;
   const double cancellation_scale_;  // see torque_sample
   const bool rigid_;
   const double zeno_window_;  // zeno_window(p_, o_), once per run
@@ -474,7 +456,7 @@ std::optional<SimulationStatus> ClosedFormRun::contact() {
   const std::optional<Crossing> separated = separation(theta0, omega0, remaining, at_separation);
   if (o_.track_extremes) {
     const auto vector = [this, theta0, omega0](double tau) { return torque_sample(tau, theta0, omega0).x; };
-    segment_extremes(p_, &*contact_velocity_, 1, vector, at, separated ? separated->t : remaining, result_.extremes);
+    segment_extremes(p_, &constants_->contact_velocity(), 1, vector, at, separated ? separated->t : remaining, result_.extremes);
   }
   const auto turns = [this, theta0, omega0](double duration, double* out, int capacity) {
     return detail::damped_turns((p_.Fm + p_.FL) / (2 * (p_.Jm + p_.JL)), p_.K / (p_.Jm + p_.JL), theta0 - p_.theta_R,
@@ -510,7 +492,7 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   start_gap_.reset();  // every later flight leaves a face
   if (o_.track_extremes) {
     const auto vector = [&flight](double tau) { return flight.vector(tau); };
-    segment_extremes(p_, free_velocities_->data(), 2, vector, at, event ? event->crossing.t : remaining, result_.extremes);
+    segment_extremes(p_, constants_->free_velocities(), 2, vector, at, event ? event->crossing.t : remaining, result_.extremes);
   }
   const auto turns = [this, &flight](double duration, double* out, int capacity) {
     return flight.turns(p_, duration, out, capacity);

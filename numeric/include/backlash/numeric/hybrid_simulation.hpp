@@ -249,4 +249,10 @@ bool inside_backlash(const Parameters& p, const HybridState& s);
 SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options);
 SimulationResult simulate_step(const ValidatedEvaluator& evaluator, double step, const SimulationOptions& options);
 
+/// How many sets of a run's parameter-set constants (the contact and free segments, the witnesses'
+/// WitnessMode constants) this process has built: simulate() builds them once per thread and
+/// parameter set, not per run (issue 19: once per map point for its ~5 runs).  A count for tests
+/// and benchmarks.
+long run_constants_built();
+
 }  // namespace backlash::numeric
