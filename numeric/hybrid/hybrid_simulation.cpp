@@ -307,6 +307,16 @@ class ClosedFormRun {
 
   SimulationResult run() {
     try {
+      return run_events();
+    } catch (...) {  // e.g. an event sink ending the run (settle.cpp): its samples so far reach the sink
+      flush_samples();
+      throw;
+    }
+  }
+
+ private:
+  SimulationResult run_events() {
+    try {
       while (t_ < o_.t_end) {
         if (!finite(state_)) return stop(SimulationStatus::NonFinite, "the state is no longer finite");
         if (events_ >= o_.max_events)
@@ -322,9 +332,8 @@ class ClosedFormRun {
     }
     return finish(SimulationStatus::Completed);
   }
-
- private:
   SimulationResult finish(SimulationStatus status) {
+    flush_samples();
     result_.status = status;
     result_.t_final = t_;
     result_.final_state = state_;
@@ -358,6 +367,12 @@ class ClosedFormRun {
   std::optional<std::string> unresolved_return(const detail::GapEvent& event) const;
   template <class At>
   void record(double upto, const At& at, FunctionRef<int(double, double*, int)> turns);
+  // θo perhaps outside the sample band (not inside by the margin), and certainly outside (by it).
+  bool keep_sample(double o) const { return !(o >= band_->low + band_->margin && o <= band_->high - band_->margin); }
+  bool last_sample(double o) const { return o < band_->low - band_->margin || o > band_->high + band_->margin; }
+  void flush_samples() {
+    if (band_) recorder_.flush([this](double o) { return keep_sample(o); }, [this](double o) { return last_sample(o); });
+  }
 
   const ValidatedEvaluator& evaluator_;
   const Parameters& p_;
@@ -483,7 +498,7 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   const bool from_line = std::fabs(state_.dtheta_m - state_.dtheta_L) <= 1e-12 * std::max(1.0, std::fabs(state_.dtheta_m)) &&
                          on_separation_line(evaluator_, theta_o, state_.dtheta_m);
   const Flight flight = from_line ? Flight::from_separation_line(evaluator_, state_) : Flight::from_state(p_, state_);
-  const auto at = [&flight](double tau) { return flight.at(tau); };
+  const auto at = [flight](double tau) { return flight.at(tau); };  // a copy: record() may keep it
   const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(p_, state_.dtheta_m))});
   const auto sample = [&flight](double tau) { return flight.gap_sample(tau); };
   const auto event = start_gap_ ? detail::first_gap_event_inside(gap_mode_, sample, *start_gap_, state_.face,
@@ -519,19 +534,19 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
 // The samples of a segment (its state `at(τ)`, τ = t − t_) at the times ≤ upto; with a sample band
 // (SimulationOptions::sample_band) none when its θo on [0, upto − t_] certainly lies in the band (at
 // both ends and at its turns, `turns`: sample_band.hpp, inside by the margin), else those the last
-// sample outside needs (TrajectoryRecorder::record_last_outside).
+// sample outside needs (TrajectoryRecorder::defer_last_outside: walked only when no later
+// segment ends certainly outside).
 template <class At>
 void ClosedFormRun::record(double upto, const At& at, FunctionRef<int(double, double*, int)> turns) {
   if (!band_) return recorder_.record(t_, upto, at);
-  const Band& b = *band_;
-  const auto keep = [&b](double o) { return !(o >= b.low + b.margin && o <= b.high - b.margin); };
-  const auto last = [&b](double o) { return o < b.low - b.margin || o > b.high + b.margin; };
+  const auto keep = [this](double o) { return keep_sample(o); };
+  const auto last = [this](double o) { return last_sample(o); };
   std::array<double, 8> times;
   const int count = turns(upto - t_, times.data(), static_cast<int>(times.size()));
   bool skip = count >= 0 && !keep(measured(p_, at(0))) && !keep(measured(p_, at(upto - t_)));
   for (int i = 0; skip && i < count; ++i) skip = !keep(measured(p_, at(times[i])));
   if (skip) recorder_.skip(upto);
-  else recorder_.record_last_outside(t_, upto, at, keep, last);
+  else recorder_.defer_last_outside(t_, upto, at, keep, last);  // `at` kept by value: it owns its segment
 }
 
 // A return to the face just left, found within the search's resolution of the certified

@@ -109,7 +109,8 @@ struct SimulationOptions {
   /// (the zeros of θ̇o, in closed form: hybrid/sample_band.hpp) lies inside the band by a margin
   /// of four times the evaluator's validated tolerance (scaled like the gate's: max(1, |θ|)); of
   /// the other segments, those inside by the margin and those before the segment's last sample
-  /// outside by the margin (found from its end backwards).  So the last sample outside the band,
+  /// outside by the margin (found from its end backwards), or before a later segment's last
+  /// sample when that one is outside by the margin (then this segment is not walked at all).  So the last sample outside the band,
   /// and every sample within the margin of its edges, reach the sink, in time order, each with
   /// its own time, as computed without the band.  Other simulators ignore it.
   struct SampleBand {
@@ -210,6 +211,47 @@ class TrajectoryRecorder {
     r_.samples_left_out += (k_ - first) - static_cast<long long>(kept_.size());
     for (auto it = kept_.rbegin(); it != kept_.rend(); ++it) push(it->first, it->second);
   }
+  /// record_last_outside, deferred (issue 19): only the segment's last sample now; the walk
+  /// backwards waits, `at` kept, until a later segment's last sample is certainly outside
+  /// (`last`: the samples before it are not needed, all left out) or the run ends (flush).  The
+  /// same samples reach the sink, in time order, except those before a later one outside.
+  template <class At, class Keep, class Last>
+  void defer_last_outside(double t0, double t_upto, const At& at, const Keep& keep, const Last& last) {
+    if (!o_.sample_times.empty() || o_.sample_interval <= 0) return record(t0, t_upto, at);
+    const long long first = k_;
+    while (static_cast<double>(k_) * o_.sample_interval <= t_upto) ++k_;
+    if (k_ == first) return;
+    const double t = static_cast<double>(k_ - 1) * o_.sample_interval;
+    const HybridState end = at(t - t0);
+    if (!last(measured(p_, end))) {
+      pending_.push_back({first, k_, t0, end, at});
+      return;
+    }
+    for (const Pending& p : pending_) r_.samples_left_out += p.end - p.first;
+    pending_.clear();
+    r_.samples_left_out += k_ - 1 - first;
+    if (keep(measured(p_, end))) push(t, end);
+  }
+  /// The walks defer_last_outside left pending, newest first, to the first sample certainly
+  /// outside; every one of the run's samples is then recorded or counted as left out.
+  template <class Keep, class Last>
+  void flush(const Keep& keep, const Last& last) {
+    kept_.clear();
+    bool found = false;
+    for (auto p = pending_.rbegin(); p != pending_.rend(); ++p) {
+      const std::size_t before = kept_.size();
+      for (long long k = p->end - 1; !found && k >= p->first; --k) {
+        const double t = static_cast<double>(k) * o_.sample_interval;
+        const HybridState h = k == p->end - 1 ? p->last : p->at(t - p->t0);
+        if (!keep(measured(p_, h))) continue;
+        kept_.push_back({t, h});
+        found = last(measured(p_, h));
+      }
+      r_.samples_left_out += (p->end - p->first) - static_cast<long long>(kept_.size() - before);
+    }
+    pending_.clear();
+    for (auto it = kept_.rbegin(); it != kept_.rend(); ++it) push(it->first, it->second);
+  }
 
  private:
   void push(double t, const HybridState& h) {
@@ -224,6 +266,13 @@ class TrajectoryRecorder {
   long long k_ = 0;
   std::size_t index_ = 0;
   std::vector<std::pair<double, HybridState>> kept_;  // record_last_outside's, reused
+  struct Pending {  // a segment's samples k in [first, end) waiting for flush
+    long long first, end;
+    double t0;
+    HybridState last;  // at(end − 1), already computed
+    std::function<HybridState(double)> at;
+  };
+  std::vector<Pending> pending_;
 };
 
 /// The state with the measured shaft at θo, both shafts moving at `velocity`, and the
