@@ -9,7 +9,7 @@
 //   item_map_point_run_constants_follow_the_parameters   runs alternating between two parameter
 //                                                 sets give each its own answer, the one of a run
 //                                                 on that set alone (the shared constants are
-//                                                 never another set's).
+//                                                 never another set's), one set kept per thread.
 // Counts and agreement only, never timings (the speed: bench/map_throughput.sh).
 #include "backlash/model/case_spec.hpp"
 #include "backlash/numeric/evaluator.hpp"
@@ -90,7 +90,7 @@ TEST(MapPointSetup, item_map_point_run_constants_follow_the_parameters) {
   const numeric::LimitCycle alone_a = numeric::find_limit_cycle(va.evaluator());
   const numeric::LimitCycle alone_b = numeric::find_limit_cycle(vb.evaluator());
   ASSERT_NE(alone_a.separation_velocity, alone_b.separation_velocity);
-  for (int round = 0; round < 3; ++round) {
+  for (int round = 0; round < 3; ++round) {  // each round starts with b's constants kept (alone_b, hb2)
     const long before = numeric::run_constants_built();
     const numeric::HalfCycle ha = numeric::half_cycle(va.evaluator(), alone_a.separation_velocity, true);
     const numeric::HalfCycle hb = numeric::half_cycle(vb.evaluator(), alone_b.separation_velocity, true);
@@ -98,6 +98,10 @@ TEST(MapPointSetup, item_map_point_run_constants_follow_the_parameters) {
     const numeric::HalfCycle ha2 = numeric::half_cycle(va.evaluator(), alone_a.separation_velocity, true);
     const numeric::HalfCycle ha3 = numeric::half_cycle(va.evaluator(), alone_a.separation_velocity, true);
     EXPECT_EQ(numeric::run_constants_built() - before, 3) << "the same set again: built once";
+    const numeric::HalfCycle hb2 = numeric::half_cycle(vb.evaluator(), alone_b.separation_velocity, true);
+    EXPECT_EQ(numeric::run_constants_built() - before, 4) << "back to the other set: built again";
+    EXPECT_EQ(hb2.v_out, hb.v_out);
+    EXPECT_EQ(hb2.extremes.theta_o_max, hb.extremes.theta_o_max);
     for (const numeric::HalfCycle* h : {&ha2, &ha3}) {
       EXPECT_EQ(h->v_out, ha.v_out);
       EXPECT_EQ(h->extremes.theta_o_max, ha.extremes.theta_o_max);
