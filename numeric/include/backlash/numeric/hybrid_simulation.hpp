@@ -192,29 +192,11 @@ class TrajectoryRecorder {
     for (; static_cast<double>(k_) * o_.sample_interval <= t_upto; ++k_) ++r_.samples_left_out;
   }
   /// record() for a caller that needs only the last θo outside a band (SimulationOptions::sample_band):
-  /// the samples from the segment's last backwards, keeping those `keep(θo)` says may be outside
+  /// the segment's samples from its last backwards, keeping those `keep(θo)` says may be outside
   /// and stopping at the first `last(θo)` says is certainly outside; the kept ones are recorded in
-  /// time order, the others counted as left out.  With sample_times: record().
-  template <class At, class Keep, class Last>
-  void record_last_outside(double t0, double t_upto, const At& at, const Keep& keep, const Last& last) {
-    if (!o_.sample_times.empty() || o_.sample_interval <= 0) return record(t0, t_upto, at);
-    const long long first = k_;
-    while (static_cast<double>(k_) * o_.sample_interval <= t_upto) ++k_;
-    kept_.clear();
-    for (long long k = k_ - 1; k >= first; --k) {
-      const double t = static_cast<double>(k) * o_.sample_interval;
-      const HybridState h = at(t - t0);
-      if (!keep(measured(p_, h))) continue;
-      kept_.push_back({t, h});
-      if (last(measured(p_, h))) break;
-    }
-    r_.samples_left_out += (k_ - first) - static_cast<long long>(kept_.size());
-    for (auto it = kept_.rbegin(); it != kept_.rend(); ++it) push(it->first, it->second);
-  }
-  /// record_last_outside, deferred (issue 19): only the segment's last sample now; the walk
-  /// backwards waits, `at` kept, until a later segment's last sample is certainly outside
-  /// (`last`: the samples before it are not needed, all left out) or the run ends (flush).  The
-  /// same samples reach the sink, in time order, except those before a later one outside.
+  /// time order, the others counted as left out.  Deferred (issue 19): only the last sample now;
+  /// the walk waits, `at` kept, until a later segment's last sample is certainly outside (then the
+  /// samples before it are not needed: all left out) or the run ends (flush).  With sample_times: record().
   template <class At, class Keep, class Last>
   void defer_last_outside(double t0, double t_upto, const At& at, const Keep& keep, const Last& last) {
     if (!o_.sample_times.empty() || o_.sample_interval <= 0) return record(t0, t_upto, at);
@@ -224,6 +206,7 @@ class TrajectoryRecorder {
     const double t = static_cast<double>(k_ - 1) * o_.sample_interval;
     const HybridState end = at(t - t0);
     if (!last(measured(p_, end))) {
+      if (pending_.size() >= 256) flush(keep, last);  // memory stays bounded (the walks then as undeferred)
       pending_.push_back({first, k_, t0, end, at});
       return;
     }
@@ -265,7 +248,7 @@ class TrajectoryRecorder {
   SimulationResult& r_;
   long long k_ = 0;
   std::size_t index_ = 0;
-  std::vector<std::pair<double, HybridState>> kept_;  // record_last_outside's, reused
+  std::vector<std::pair<double, HybridState>> kept_;  // flush's, reused
   struct Pending {  // a segment's samples k in [first, end) waiting for flush
     long long first, end;
     double t0;
