@@ -296,7 +296,7 @@ class ClosedFormRun {
         p_(evaluator.parameters()),
         o_(options),
         recorder_(p_, options, result_),
-        constants_(detail::run_constants(p_)),
+        constants_(p_),
         cancellation_scale_(4096 * std::numeric_limits<double>::epsilon() * std::fabs(torque_.r(0)) *
                             std::max(1.0, std::fabs(p_.theta_R))),
         rigid_(p_.backlash <= 0),  // a rigid drive: contact for ever, no events
@@ -381,7 +381,7 @@ class ClosedFormRun {
   TrajectoryRecorder recorder_;
   // The witnesses' constants, once per thread and parameter set (run_constants.hpp):
   // Tc in contact, the gap in flight, and (track_extremes) the velocities.
-  const std::shared_ptr<const detail::RunConstants> constants_;
+  const detail::RunConstantsLease constants_;
   const TransmittedTorque& torque_ = constants_->torque;
   const WitnessMode& contact_mode_ = constants_->contact_mode;
   const WitnessMode& gap_mode_ = constants_->gap_mode;

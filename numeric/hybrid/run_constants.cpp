@@ -6,6 +6,7 @@
 #include "backlash/numeric/scales.hpp"
 #include "hybrid/gap_events.hpp"
 
+#include <array>
 #include <atomic>
 #include <cstring>
 
@@ -55,10 +56,34 @@ const RunConstants::Velocities& RunConstants::velocities() const {
   return *velocities_;
 }
 
-std::shared_ptr<const RunConstants> run_constants(const Parameters& p) {
-  thread_local std::shared_ptr<const RunConstants> last;
-  if (!last || !same(last->parameters, p)) last = std::make_shared<const RunConstants>(p);
-  return last;
+namespace {
+
+struct Kept {
+  std::optional<RunConstants> constants;
+  int users = 0;
+};
+
+}  // namespace
+
+RunConstantsLease::RunConstantsLease(const Parameters& p) {
+  thread_local std::array<Kept, 2> kept;
+  Kept* slot = nullptr;
+  for (Kept& k : kept)
+    if (!slot && k.constants && same(k.constants->parameters, p)) slot = &k;
+  for (Kept& k : kept)
+    if (!slot && k.users == 0) (slot = &k)->constants.emplace(p);
+  if (!slot) {
+    own_ = std::make_unique<RunConstants>(p);
+    constants_ = own_.get();
+    return;
+  }
+  users_ = &slot->users;
+  ++*users_;
+  constants_ = &*slot->constants;
+}
+
+RunConstantsLease::~RunConstantsLease() {
+  if (users_) --*users_;
 }
 
 }  // namespace detail

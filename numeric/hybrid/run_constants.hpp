@@ -39,8 +39,22 @@ struct RunConstants {
   mutable std::optional<Velocities> velocities_;
 };
 
-/// The constants of `p`: this thread's last set when `p` is the same parameter set bit for bit,
-/// else a new one (then kept).  Shared: a run holds its set while a nested run replaces the cache.
-std::shared_ptr<const RunConstants> run_constants(const Parameters& p);
+/// The constants of `p` for one run, without allocating: this thread's kept set when `p` is the
+/// same parameter set bit for bit, else built in place of one no run is using (two kept per
+/// thread: a run and one nested run of another set, e.g. settle.cpp's check inside its step
+/// response; deeper nesting builds its own).  Held for the run's lifetime.
+class RunConstantsLease {
+ public:
+  explicit RunConstantsLease(const Parameters& p);
+  ~RunConstantsLease();
+  RunConstantsLease(const RunConstantsLease&) = delete;
+  RunConstantsLease& operator=(const RunConstantsLease&) = delete;
+  const RunConstants* operator->() const { return constants_; }
+
+ private:
+  int* users_ = nullptr;  // the kept set's count of runs holding it
+  std::unique_ptr<RunConstants> own_;
+  const RunConstants* constants_ = nullptr;
+};
 
 }  // namespace backlash::numeric::detail
