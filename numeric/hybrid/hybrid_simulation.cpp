@@ -6,6 +6,7 @@
 #include "backlash/numeric/segment_dynamics.hpp"
 #include "hybrid/gap_events.hpp"
 #include "hybrid/rest_search.hpp"
+#include "hybrid/run_constants.hpp"
 #include "hybrid/sample_band.hpp"
 
 #include <boost/math/tools/roots.hpp>
@@ -185,13 +186,6 @@ bool on_separation_line(const ValidatedEvaluator& evaluator, double theta_o, dou
   return std::fabs(theta_o - line) <= 1e-9 * scale;
 }
 
-// The witness of one velocity (row of x) on a segment: its zeros are the extremes of the angle.
-WitnessMode velocity_mode(const LinearSegment& segment, Eigen::Index row, double time_unit) {
-  SmallRow e = SmallRow::Zero(segment.A.rows());
-  e(row) = 1;
-  return WitnessMode(segment.A, segment.c, e, time_unit);
-}
-
 // Extremes of a segment on [0, duration]: its end states and the certified zeros of the
 // velocities whose witnesses are `velocity_modes` (θ̇m and θ̇L; in contact both are θ̇o).
 // `vector(τ)` is the segment's state x, x' = A x + c.
@@ -303,27 +297,26 @@ class ClosedFormRun {
         p_(evaluator.parameters()),
         o_(options),
         recorder_(p_, options, result_),
-        contact_segment_(contact_mode_segment(p_)),
-        free_segment_(free_mode_segment(p_)),
-        torque_(transmitted_torque(p_)),
-        contact_mode_(contact_segment_.A, contact_segment_.c, torque_.r, servo_time_unit(p_)),
-        gap_mode_(detail::gap_witness_mode(free_segment_, servo_time_unit(p_))),
+        constants_(p_),
         cancellation_scale_(4096 * std::numeric_limits<double>::epsilon() * std::fabs(torque_.r(0)) *
                             std::max(1.0, std::fabs(p_.theta_R))),
         rigid_(p_.backlash <= 0),  // a rigid drive: contact for ever, no events
         zeno_window_(zeno_window(p_, o_)),
         state_(rigid_ ? rigid_start(p_, start) : start),
         start_gap_(rigid_ || start.in_contact ? std::nullopt : start_gap),
-        band_(band) {
-    if (o_.track_extremes) {
-      const double unit = servo_time_unit(p_);
-      contact_velocity_.emplace(velocity_mode(contact_segment_, 1, unit));
-      free_velocities_.emplace(
-          std::array<WitnessMode, 2>{velocity_mode(free_segment_, 1, unit), velocity_mode(free_segment_, 3, unit)});
+        band_(band) {}
+
+  SimulationResult run() {
+    try {
+      return run_events();
+    } catch (...) {  // e.g. an event sink ending the run (settle.cpp): its samples so far reach the sink
+      flush_samples();
+      throw;
     }
   }
 
-  SimulationResult run() {
+ private:
+  SimulationResult run_events() {
     try {
       while (t_ < o_.t_end) {
         if (!finite(state_)) return stop(SimulationStatus::NonFinite, "the state is no longer finite");
@@ -340,9 +333,8 @@ class ClosedFormRun {
     }
     return finish(SimulationStatus::Completed);
   }
-
- private:
   SimulationResult finish(SimulationStatus status) {
+    flush_samples();
     result_.status = status;
     result_.t_final = t_;
     result_.final_state = state_;
@@ -376,19 +368,24 @@ class ClosedFormRun {
   std::optional<std::string> unresolved_return(const detail::GapEvent& event) const;
   template <class At>
   void record(double upto, const At& at, FunctionRef<int(double, double*, int)> turns);
+  // θo perhaps outside the sample band (not inside by the margin), and certainly outside (by it).
+  bool keep_sample(double o) const { return !(o >= band_->low + band_->margin && o <= band_->high - band_->margin); }
+  bool last_sample(double o) const { return o < band_->low - band_->margin || o > band_->high + band_->margin; }
+  void flush_samples() {
+    if (band_) recorder_.flush([this](double o) { return keep_sample(o); }, [this](double o) { return last_sample(o); });
+  }
 
   const ValidatedEvaluator& evaluator_;
   const Parameters& p_;
   const SimulationOptions& o_;
   SimulationResult result_;
   TrajectoryRecorder recorder_;
-  const LinearSegment contact_segment_, free_segment_;
-  const TransmittedTorque torque_;
-  // The witnesses' constants, once per run (mode and parameter set): Tc in contact, the gap in flight,
-  // and (track_extremes) the velocities.
-  const WitnessMode contact_mode_, gap_mode_;
-  std::optional<WitnessMode> contact_velocity_;
-  std::optional<std::array<WitnessMode, 2>> free_velocities_;
+  // The witnesses' constants, once per thread and parameter set (run_constants.hpp):
+  // Tc in contact, the gap in flight, and (track_extremes) the velocities.
+  const detail::RunConstantsLease constants_;
+  const TransmittedTorque& torque_ = constants_->torque;
+  const WitnessMode& contact_mode_ = constants_->contact_mode;
+  const WitnessMode& gap_mode_ = constants_->gap_mode;
   const double cancellation_scale_;  // see torque_sample
   const bool rigid_;
   const double zeno_window_;  // zeno_window(p_, o_), once per run
@@ -475,7 +472,7 @@ std::optional<SimulationStatus> ClosedFormRun::contact() {
   const std::optional<Crossing> separated = separation(theta0, omega0, remaining, at_separation);
   if (o_.track_extremes) {
     const auto vector = [this, theta0, omega0](double tau) { return torque_sample(tau, theta0, omega0).x; };
-    segment_extremes(p_, &*contact_velocity_, 1, vector, at, separated ? separated->t : remaining, result_.extremes);
+    segment_extremes(p_, &constants_->contact_velocity(), 1, vector, at, separated ? separated->t : remaining, result_.extremes);
   }
   const auto turns = [this, theta0, omega0](double duration, double* out, int capacity) {
     return detail::damped_turns((p_.Fm + p_.FL) / (2 * (p_.Jm + p_.JL)), p_.K / (p_.Jm + p_.JL), theta0 - p_.theta_R,
@@ -502,7 +499,7 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   const bool from_line = std::fabs(state_.dtheta_m - state_.dtheta_L) <= 1e-12 * std::max(1.0, std::fabs(state_.dtheta_m)) &&
                          on_separation_line(evaluator_, theta_o, state_.dtheta_m, gap_mode_.time_unit);
   const Flight flight = from_line ? Flight::from_separation_line(evaluator_, state_) : Flight::from_state(p_, state_);
-  const auto at = [&flight](double tau) { return flight.at(tau); };
+  const auto at = [flight](double tau) { return flight.at(tau); };  // a copy: record() may keep it
   const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(gap_mode_.time_unit, state_.dtheta_m))});
   const auto sample = [&flight](double tau) { return flight.gap_sample(tau); };
   const auto event = start_gap_ ? detail::first_gap_event_inside_with(gap_mode_, sample, *start_gap_, state_.face,
@@ -511,7 +508,7 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   start_gap_.reset();  // every later flight leaves a face
   if (o_.track_extremes) {
     const auto vector = [&flight](double tau) { return flight.vector(tau); };
-    segment_extremes(p_, free_velocities_->data(), 2, vector, at, event ? event->crossing.t : remaining, result_.extremes);
+    segment_extremes(p_, constants_->free_velocities(), 2, vector, at, event ? event->crossing.t : remaining, result_.extremes);
   }
   const auto turns = [this, &flight](double duration, double* out, int capacity) {
     return flight.turns(p_, duration, out, capacity);
@@ -538,19 +535,19 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
 // The samples of a segment (its state `at(τ)`, τ = t − t_) at the times ≤ upto; with a sample band
 // (SimulationOptions::sample_band) none when its θo on [0, upto − t_] certainly lies in the band (at
 // both ends and at its turns, `turns`: sample_band.hpp, inside by the margin), else those the last
-// sample outside needs (TrajectoryRecorder::record_last_outside).
+// sample outside needs (TrajectoryRecorder::defer_last_outside: walked only when no later
+// segment ends certainly outside).
 template <class At>
 void ClosedFormRun::record(double upto, const At& at, FunctionRef<int(double, double*, int)> turns) {
   if (!band_) return recorder_.record(t_, upto, at);
-  const Band& b = *band_;
-  const auto keep = [&b](double o) { return !(o >= b.low + b.margin && o <= b.high - b.margin); };
-  const auto last = [&b](double o) { return o < b.low - b.margin || o > b.high + b.margin; };
+  const auto keep = [this](double o) { return keep_sample(o); };
+  const auto last = [this](double o) { return last_sample(o); };
   std::array<double, 8> times;
   const int count = turns(upto - t_, times.data(), static_cast<int>(times.size()));
   bool skip = count >= 0 && !keep(measured(p_, at(0))) && !keep(measured(p_, at(upto - t_)));
   for (int i = 0; skip && i < count; ++i) skip = !keep(measured(p_, at(times[i])));
   if (skip) recorder_.skip(upto);
-  else recorder_.record_last_outside(t_, upto, at, keep, last);
+  else recorder_.defer_last_outside(t_, upto, at, keep, last);  // `at` kept by value: it owns its segment
 }
 
 // A return to the face just left, found within the search's resolution of the certified

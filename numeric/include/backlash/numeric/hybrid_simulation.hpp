@@ -109,7 +109,8 @@ struct SimulationOptions {
   /// (the zeros of θ̇o, in closed form: hybrid/sample_band.hpp) lies inside the band by a margin
   /// of four times the evaluator's validated tolerance (scaled like the gate's: max(1, |θ|)); of
   /// the other segments, those inside by the margin and those before the segment's last sample
-  /// outside by the margin (found from its end backwards).  So the last sample outside the band,
+  /// outside by the margin (found from its end backwards), or before a later segment's last
+  /// sample when that one is outside by the margin (then this segment is not walked at all).  So the last sample outside the band,
   /// and every sample within the margin of its edges, reach the sink, in time order, each with
   /// its own time, as computed without the band.  Other simulators ignore it.
   struct SampleBand {
@@ -191,23 +192,47 @@ class TrajectoryRecorder {
     for (; static_cast<double>(k_) * o_.sample_interval <= t_upto; ++k_) ++r_.samples_left_out;
   }
   /// record() for a caller that needs only the last θo outside a band (SimulationOptions::sample_band):
-  /// the samples from the segment's last backwards, keeping those `keep(θo)` says may be outside
+  /// the segment's samples from its last backwards, keeping those `keep(θo)` says may be outside
   /// and stopping at the first `last(θo)` says is certainly outside; the kept ones are recorded in
-  /// time order, the others counted as left out.  With sample_times: record().
+  /// time order, the others counted as left out.  Deferred (issue 19): only the last sample now;
+  /// the walk waits, `at` kept, until a later segment's last sample is certainly outside (then the
+  /// samples before it are not needed: all left out) or the run ends (flush).  With sample_times: record().
   template <class At, class Keep, class Last>
-  void record_last_outside(double t0, double t_upto, const At& at, const Keep& keep, const Last& last) {
+  void defer_last_outside(double t0, double t_upto, const At& at, const Keep& keep, const Last& last) {
     if (!o_.sample_times.empty() || o_.sample_interval <= 0) return record(t0, t_upto, at);
     const long long first = k_;
     while (static_cast<double>(k_) * o_.sample_interval <= t_upto) ++k_;
-    kept_.clear();
-    for (long long k = k_ - 1; k >= first; --k) {
-      const double t = static_cast<double>(k) * o_.sample_interval;
-      const HybridState h = at(t - t0);
-      if (!keep(measured(p_, h))) continue;
-      kept_.push_back({t, h});
-      if (last(measured(p_, h))) break;
+    if (k_ == first) return;
+    const double t = static_cast<double>(k_ - 1) * o_.sample_interval;
+    const HybridState end = at(t - t0);
+    if (!last(measured(p_, end))) {
+      if (pending_.size() >= 256) flush(keep, last);  // memory stays bounded (the walks then as undeferred)
+      pending_.push_back({first, k_, t0, end, at});
+      return;
     }
-    r_.samples_left_out += (k_ - first) - static_cast<long long>(kept_.size());
+    for (const Pending& p : pending_) r_.samples_left_out += p.end - p.first;
+    pending_.clear();
+    r_.samples_left_out += k_ - 1 - first;
+    if (keep(measured(p_, end))) push(t, end);
+  }
+  /// The walks defer_last_outside left pending, newest first, to the first sample certainly
+  /// outside; every one of the run's samples is then recorded or counted as left out.
+  template <class Keep, class Last>
+  void flush(const Keep& keep, const Last& last) {
+    kept_.clear();
+    bool found = false;
+    for (auto p = pending_.rbegin(); p != pending_.rend(); ++p) {
+      const std::size_t before = kept_.size();
+      for (long long k = p->end - 1; !found && k >= p->first; --k) {
+        const double t = static_cast<double>(k) * o_.sample_interval;
+        const HybridState h = k == p->end - 1 ? p->last : p->at(t - p->t0);
+        if (!keep(measured(p_, h))) continue;
+        kept_.push_back({t, h});
+        found = last(measured(p_, h));
+      }
+      r_.samples_left_out += (p->end - p->first) - static_cast<long long>(kept_.size() - before);
+    }
+    pending_.clear();
     for (auto it = kept_.rbegin(); it != kept_.rend(); ++it) push(it->first, it->second);
   }
 
@@ -223,7 +248,14 @@ class TrajectoryRecorder {
   SimulationResult& r_;
   long long k_ = 0;
   std::size_t index_ = 0;
-  std::vector<std::pair<double, HybridState>> kept_;  // record_last_outside's, reused
+  std::vector<std::pair<double, HybridState>> kept_;  // flush's, reused
+  struct Pending {  // a segment's samples k in [first, end) waiting for flush
+    long long first, end;
+    double t0;
+    HybridState last;  // at(end − 1), already computed
+    std::function<HybridState(double)> at;
+  };
+  std::vector<Pending> pending_;
 };
 
 /// The state with the measured shaft at θo, both shafts moving at `velocity`, and the
@@ -248,5 +280,11 @@ bool inside_backlash(const Parameters& p, const HybridState& s);
 /// a recombination on −σ.
 SimulationResult simulate(const ValidatedEvaluator& evaluator, const HybridState& start, const SimulationOptions& options);
 SimulationResult simulate_step(const ValidatedEvaluator& evaluator, double step, const SimulationOptions& options);
+
+/// How many sets of a run's parameter-set constants (the contact and free segments, the witnesses'
+/// WitnessMode constants) this process has built: simulate() builds them once per thread and
+/// parameter set, not per run (issue 19: once per map point for its ~5 runs).  A count for tests
+/// and benchmarks.
+long run_constants_built();
 
 }  // namespace backlash::numeric
