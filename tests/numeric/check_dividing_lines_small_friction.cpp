@@ -14,6 +14,7 @@
 //   item20_quiet_tail_bound_holds  the bound on |f''''| the certificate rests on holds at sampled
 //        points of random flights (beyond the samples' own rounding).
 #include "counting_evaluator.hpp"
+#include "thesis_cases_two_to_four.hpp"
 
 #include "backlash/numeric/dividing_lines.hpp"
 #include "backlash/numeric/evaluator.hpp"
@@ -37,15 +38,8 @@ namespace {
 using namespace backlash;
 using namespace backlash::numeric;
 
-// The thesis's cases II–IV (cases/*.toml: K = 1, b = 0.3) with the load's friction FL, in error
-// coordinates (θR = 0) as the facade runs them.
-Parameters thesis_case(int number, double FL) {
-  Parameters p;
-  p.K = 1, p.theta_R = 0, p.backlash = 0.3, p.FL = FL;
-  p.Jm = number == 4 ? 0.2 : 0.5, p.Fm = 0.2, p.JL = number == 4 ? 0.8 : 0.5;
-  p.measured_at = number == 2 ? model::MeasuredAt::Motor : model::MeasuredAt::Load;
-  return p;
-}
+// The thesis's cases II–IV with the load's friction FL (θR = 0: the error coordinates the facade runs them in).
+Parameters thesis_case(int number, double FL) { return backlash::testing::thesis_case_two_to_four(number, FL, 0); }
 
 // The explorer's grid: the default one and its negatives (both faces).
 std::vector<double> both_faces() {

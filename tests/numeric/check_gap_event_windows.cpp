@@ -16,6 +16,7 @@
 #include "backlash/numeric/validated_family.hpp"
 #include "hybrid/gap_events.hpp"
 #include "hybrid/linear_flight.hpp"
+#include "thesis_cases_two_to_four.hpp"
 
 #include <gtest/gtest.h>
 
@@ -32,14 +33,8 @@ using namespace backlash::numeric;
 using detail::GapEvent;
 using detail::GapEventKind;
 
-// The thesis's cases II–IV (cases/*.toml: K = 1, θR = 1, b = 0.3) with the load's friction FL.
-Parameters thesis_case(int number, double FL) {
-  Parameters p;
-  p.K = 1, p.theta_R = 1, p.backlash = 0.3, p.FL = FL;
-  p.Jm = number == 4 ? 0.2 : 0.5, p.Fm = 0.2, p.JL = number == 4 ? 0.8 : 0.5;
-  p.measured_at = number == 2 ? model::MeasuredAt::Motor : model::MeasuredAt::Load;
-  return p;
-}
+// The thesis's cases II–IV with the load's friction FL (θR = 1, as the case files).
+Parameters thesis_case(int number, double FL) { return backlash::testing::thesis_case_two_to_four(number, FL, 1); }
 
 // The code before the windows (gap_events.cpp at main): the opposite face over the whole horizon,
 // then the return to the face left up to it.
