@@ -48,8 +48,8 @@ std::optional<GapEvent> sequential_event(const WitnessMode& mode, FunctionRef<Wi
   if (t0)
     back = first_crossing_after_departure(mode, sample, *t0, certified_clearance(mode, x0, *t0, noise),
                                           opposite ? opposite->t : horizon);
-  if (back && (!opposite || back->t < opposite->t)) return GapEvent{GapEventKind::FaceLeft, *back, *t0};
-  if (opposite) return GapEvent{GapEventKind::OppositeFace, *opposite};
+  if (back && (!opposite || back->t < opposite->t)) return GapEvent{GapEventKind::FaceLeft, *back, *t0, false, {}};
+  if (opposite) return GapEvent{GapEventKind::OppositeFace, *opposite, 0, false, {}};
   return std::nullopt;
 }
 
@@ -58,8 +58,8 @@ std::optional<GapEvent> sequential_event_inside(const WitnessMode& mode, Functio
                                                 double start_gap, int face, double half, double horizon) {
   const std::optional<Crossing> same = first_crossing(mode, sample, face * half - start_gap, 0, horizon);
   const std::optional<Crossing> opposite = first_crossing(mode, sample, -face * half - start_gap, 0, same ? same->t : horizon);
-  if (opposite && (!same || opposite->t < same->t)) return GapEvent{GapEventKind::OppositeFace, *opposite, 0, true};
-  if (same) return GapEvent{GapEventKind::FaceLeft, *same, 0, true};
+  if (opposite && (!same || opposite->t < same->t)) return GapEvent{GapEventKind::OppositeFace, *opposite, 0, true, {}};
+  if (same) return GapEvent{GapEventKind::FaceLeft, *same, 0, true, {}};
   return std::nullopt;
 }
 

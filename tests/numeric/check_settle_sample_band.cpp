@@ -124,7 +124,9 @@ TEST(SettleSampleBand, item1_settle_time_as_with_every_sample) {
       while (k > 0 && inside(full.at(k - 1))) --k;
       const bool settled = inside(full.rbegin()->second);
       EXPECT_EQ(got.status, settled ? "settled" : "not_settled") << s.name << ", fraction " << fraction;
-      if (settled) EXPECT_EQ(got.time, static_cast<double>(k) * o.t_end / o.samples) << s.name << ", fraction " << fraction;
+      if (settled) {
+        EXPECT_EQ(got.time, static_cast<double>(k) * o.t_end / o.samples) << s.name << ", fraction " << fraction;
+      }
     }
   }
 }
