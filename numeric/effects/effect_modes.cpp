@@ -27,11 +27,6 @@ double drive_at(const Parameters& p, const Effects& e, double theta_o, int regim
 
 }  // namespace
 
-FlowCounts& flow_counts() {
-  thread_local FlowCounts counts;
-  return counts;
-}
-
 std::string Mode::describe() const {
   std::ostringstream out;
   auto slip = [](int s) { return s > 0 ? "+" : s < 0 ? "-" : "stuck"; };
@@ -124,7 +119,6 @@ struct ModeFlow::Generic {
     thread_local std::size_t next = 0;
     for (const Decomposition& d : cache)
       if (d.m == m && d.M == M) return d;
-    ++flow_counts().decompositions;
     Decomposition d;
     d.M = M;
     d.m = m;
@@ -374,7 +368,6 @@ CoupledKernels ModeFlow::free_kernels(double x, double y) const {
 }
 
 SmallVector ModeFlow::local(double tau) const {
-  ++flow_counts().evaluations;
   const Mode& m = mode_;
   if (generic_) return generic_->at(tau);
   if (m.kind == ModeKind::Contact) {

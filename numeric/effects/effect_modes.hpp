@@ -50,15 +50,6 @@
 
 namespace backlash::numeric {
 
-/// The closed-form evaluations (ModeFlow::local) and the eigen-decompositions of mesh matrices
-/// made on this thread so far: the units the engine's cost is counted in (tests/numeric/
-/// check_effects_engine_searches.cpp bounds them per event).
-struct FlowCounts {
-  long evaluations = 0;
-  long decompositions = 0;
-};
-FlowCounts& flow_counts();
-
 /// Every mode the model can enter (for the gate): kinds × faces × regimes × slips.
 std::vector<Mode> reachable_modes(const Parameters& p, const Effects& e);
 

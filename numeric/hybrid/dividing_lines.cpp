@@ -139,11 +139,11 @@ using detail::UnitGapProfile;
 // shorter horizon gains nothing); each try within kQuietTailBudget intervals.
 constexpr long kQuietTailBudget = 400;
 
-std::optional<double> quiet_start(const ValidatedEvaluator& evaluator, double t0, double horizon) {
+std::optional<double> quiet_start(const ValidatedEvaluator& evaluator, const std::function<SmallVector(double)>& state,
+                                  double t0, double horizon) {
   const Parameters& p = evaluator.parameters();
   const LinearSegment free = free_mode_segment(p);
   const double window = detail::gap_witness_mode(free, servo_time_unit(p)).first_window;
-  const std::function<SmallVector(double)> state = gap_witness(evaluator, 1.0, 0).state;
   for (int k = 3; k < 60; k += 2) {
     const double from = t0 + window * (std::ldexp(1.0, k) - 1);
     if (!(from <= horizon / 8)) break;
@@ -177,7 +177,7 @@ UnitGapProfile detail::unit_gap_profile(const ValidatedEvaluator& evaluator, dou
   const std::optional<double> t0 = return_search_start(evaluator, unit);
   if (!t0) return profile;
   const LinearWitness gap = gap_witness(evaluator, unit, 0);
-  const std::optional<double> quiet = quiet_tail ? quiet_start(evaluator, *t0, horizon) : std::nullopt;
+  const std::optional<double> quiet = quiet_tail ? quiet_start(evaluator, gap.state, *t0, horizon) : std::nullopt;
   std::optional<Crossing> back;
   const auto stopped = [&profile, horizon](const SearchBudgetExhausted& budget, double from) {
     profile.complete = false;

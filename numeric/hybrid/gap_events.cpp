@@ -167,7 +167,6 @@ std::optional<LevelEvent> first_of_two_levels(const Level& first, const Level& s
   return windowed_levels(first, second, horizon, first_window, samples);
 }
 
-
 std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
                                         double opposite_face_change, double horizon, double position_scale) {
   return first_gap_event_with(gap_mode, sample, opposite_face_change, horizon, position_scale);

@@ -131,6 +131,4 @@ std::optional<GapEvent> first_gap_event_inside_with(const WitnessMode& gap_mode,
   return GapEvent{GapEventKind::FaceLeft, event->crossing, 0, true, {}};
 }
 
-WitnessMode gap_witness_mode(const LinearSegment& free_segment, double time_unit);
-
 }  // namespace backlash::numeric::detail

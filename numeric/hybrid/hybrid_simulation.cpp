@@ -176,7 +176,7 @@ class Flight {
 };
 
 // A velocity as the angle it sweeps in the servo's time unit √(J/K) (servo_time_unit, 1 s for the
-// thesis's cases; the run's modes keep it): the scale of a state's angles for rounding
+// thesis's cases; the run's constants keep it): the scale of a state's angles for rounding
 // tolerances, whatever the gain.
 double swept_angle(double time_unit, double velocity) { return velocity * time_unit; }
 
@@ -497,10 +497,10 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   const double remaining = o_.t_end - t_;
   const double theta_o = measured(p_, state_);
   const bool from_line = std::fabs(state_.dtheta_m - state_.dtheta_L) <= 1e-12 * std::max(1.0, std::fabs(state_.dtheta_m)) &&
-                         on_separation_line(evaluator_, theta_o, state_.dtheta_m, gap_mode_.time_unit);
+                         on_separation_line(evaluator_, theta_o, state_.dtheta_m, constants_->time_unit);
   const Flight flight = from_line ? Flight::from_separation_line(evaluator_, state_) : Flight::from_state(p_, state_);
   const auto at = [flight](double tau) { return flight.at(tau); };  // a copy: record() may keep it
-  const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(gap_mode_.time_unit, state_.dtheta_m))});
+  const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(constants_->time_unit, state_.dtheta_m))});
   const auto sample = [&flight](double tau) { return flight.gap_sample(tau); };
   const auto event = start_gap_ ? detail::first_gap_event_inside_with(gap_mode_, sample, *start_gap_, state_.face,
                                                                       p_.backlash / 2, remaining)

@@ -1,5 +1,5 @@
-// The effects engine per event (issue 19): what a segment's searches and a mesh mode's flow cost,
-// counted (effect_modes.hpp, flow_counts), not timed.
+// The effects engine per event (issue 19): a mesh mode's flow, a segment's kept witness constants
+// and a free flight's kernels, as the engine's speed-ups left them.
 //   compliance_flow_is_the_augmented_exponential
 //                                 a mesh mode's flow (its kept eigen-decomposition) is the
 //                                 augmented matrix's exponential e^{Mτ} z̃0 (Eigen's Padé) within
