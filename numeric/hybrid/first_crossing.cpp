@@ -2,6 +2,7 @@
 
 #include "hybrid/balancing.hpp"
 #include "hybrid/certified_search.hpp"
+#include "hybrid/gap_events.hpp"
 
 #include <cmath>
 #include <functional>
@@ -176,6 +177,10 @@ double last_within(double first_guess, double t0, double bound, double growth, d
 }
 
 double certified_clearance(const WitnessMode& W, const SmallVector& x0, double t0, double noise) {
+  return detail::certified_clearance(W, x0, t0, noise, nullptr);
+}
+
+double detail::certified_clearance(const WitnessMode& W, const SmallVector& x0, double t0, double noise, int* sign) {
   const StartRates r = start_rates(W, x0);
   const double z0 = r.z0;
   const double second = std::fabs(r.second), third = std::fabs(r.third);
@@ -186,6 +191,7 @@ double certified_clearance(const WitnessMode& W, const SmallVector& x0, double t
     // w'' leads (certified_departure's first case): |w(t) − w''(0)t²/2| ≤ sup|w'''| t³/6, so
     // |w(t)| ≥ |w''(0)| t²/4 while t·sup|w'''| ≤ 1.5|w''(0)|, sup|w'''| ≤ ‖eA²D⁻¹‖₁ e^{μ⁺t} z0.
     if (!(second > rounding) || !(second * t0 * t0 / 4 >= noise / 8)) return 0;
+    if (sign) *sign = r.second > 0 ? 1 : -1;
     return last_within(1.5 * second / (W.norm_eA2 * z0), t0, W.norm_eA2, growth, z0, 1.5 * second);
   }
   // w''' leads (the separation line, w''(0) = 0 up to rounding): |w(t) − w'''(0)t³/6| ≤
@@ -194,6 +200,7 @@ double certified_clearance(const WitnessMode& W, const SmallVector& x0, double t
   if (!std::isfinite(third) || !(third > 0) || !((second + rounding) / (2 * t0) <= third / 24) ||
       !(third * t0 * t0 * t0 / 12 >= noise / 8))
     return 0;
+  if (sign) *sign = r.third > 0 ? 1 : -1;
   return last_within(third / (W.norm_eA3 * z0), t0, W.norm_eA3, growth, z0, third);
 }
 

@@ -119,7 +119,8 @@ struct Windowed {
 };
 
 // After the first level's first stretch found nothing: both levels window by window.
-Windowed windowed_search(Track& a, Track& b, const long& samples) {
+// `first_settles`: a crossing of the first level that is not grazing is the event (first_of_two_levels).
+Windowed windowed_search(Track& a, Track& b, const long& samples, bool first_settles) {
   const long budget = CrossingOptions{}.max_intervals;
   try {
     for (;;) {
@@ -130,7 +131,7 @@ Windowed windowed_search(Track& a, Track& b, const long& samples) {
         if (const auto w = b.whole()) return {true, LevelEvent{true, *w}};
         break;
       }
-      if (a.found && b.clear_beyond(a.found->t * (1 + 1e-9))) {
+      if (a.found && (first_settles || b.clear_beyond(a.found->t * (1 + 1e-9)))) {
         if (const auto w = a.whole()) return {true, LevelEvent{false, *w}};
         break;
       }
@@ -149,11 +150,12 @@ Windowed windowed_search(Track& a, Track& b, const long& samples) {
 // whole horizon) is the reference's, and the second level is then searched as the reference does
 // —, else both levels window by window, and the sequential searches where they cannot settle.
 std::optional<LevelEvent> windowed_levels(const Level& first, const Level& second, double horizon, double first_window,
-                                          const long& samples) {
+                                          const long& samples, bool first_settles) {
   Track a(first, horizon, first_window), b(second, horizon, first_window);
   a.advance(-INFINITY, kFirstStretchWindows);
+  if (first_settles && a.found && !a.found->grazing) return LevelEvent{false, *a.found};
   if (a.exhausted()) return with_second(a.found, second, horizon);
-  const Windowed windowed = windowed_search(a, b, samples);
+  const Windowed windowed = windowed_search(a, b, samples, first_settles);
   if (windowed.settled) return windowed.event;
   return sequential_search(first, second, horizon);
 }
@@ -162,9 +164,23 @@ std::optional<LevelEvent> windowed_levels(const Level& first, const Level& secon
 
 // The two levels, window by window when the mode has a time scale, else one after the other.
 std::optional<LevelEvent> first_of_two_levels(const Level& first, const Level& second, double horizon,
-                                              double first_window, const long& samples) {
+                                              double first_window, const long& samples, bool first_settles) {
   if (!(first_window > 0) || !std::isfinite(first_window)) return sequential_search(first, second, horizon);
-  return windowed_levels(first, second, horizon, first_window, samples);
+  return windowed_levels(first, second, horizon, first_window, samples, first_settles);
+}
+
+// The gap rate of a free flight (free_mode_segment): θ̇L' = −(FL/JL) θ̇L, so (D + a) θ̇L = 0 with
+// a = FL/JL.  Output at the load: Jm θ̈m = K(θR − θL) − Fm θ̇m, so (D + b) θ̇m = (K/Jm)(θR − θL),
+// b = Fm/Jm; D(D + b) θ̇m = −(K/Jm) θ̇L and (D + a) D (D + b) θ̇m = 0.  Output at the motor:
+// Jm θ̈m = K(θR − θm) − Fm θ̇m, so (D² + bD + K/Jm) θ̇m = 0.  Either way (D + a)·q(D) annihilates
+// θ̇L − θ̇m with q of degree 2, and when all three roots are real a nonzero solution has at most
+// two real zeros counted with multiplicity (an exponential polynomial Σ P_i(t) e^{λ_i t} with real
+// λ_i has at most Σ (deg P_i + 1) − 1: divide by e^{λ_1 t} and apply Rolle's theorem deg P_1 + 1
+// times).  The motor's roots are real when b² ≥ 4K/Jm, i.e. Fm² ≥ 4 K Jm, asked here with a
+// margin far above the rounding of these products (near critical damping the answer is "no").
+bool gap_rate_turns_at_most_once(const Parameters& p) {
+  if (p.measured_at == model::MeasuredAt::Load) return true;
+  return p.Fm * p.Fm > 4 * p.K * p.Jm * (1 + 1e-9);
 }
 
 std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,

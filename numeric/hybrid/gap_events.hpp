@@ -46,6 +46,10 @@ std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef
 std::optional<GapEvent> first_gap_event_inside(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
                                                double start_gap, int face, double half, double horizon);
 
+/// certified_clearance (first_crossing.hpp) that also writes, when its t1 > 0, the sign of w on
+/// (0, t1] (its leading term's, w''(0) or w'''(0)) to `sign`.
+double certified_clearance(const WitnessMode& mode, const SmallVector& x0, double t0, double noise, int* sign);
+
 /// The gap witness's mode: e = θL − θm on the free segment.
 WitnessMode gap_witness_mode(const LinearSegment& free_segment, double time_unit);
 
@@ -66,14 +70,40 @@ struct LevelEvent {
 /// The first crossing of either level within `horizon`, as the two searches one after the other
 /// find it (the first level over the horizon, the second up to its crossing), window by window
 /// when the mode has a time scale (`first_window`); `samples` counts the samples taken so far.
+/// `first_settles`: the second level is known not to cross before a crossing of the first that is
+/// not grazing (a flight whose gap turns at most once, gap_rate_turns_at_most_once), so such a
+/// crossing is the event without the second level's search up to it.
 std::optional<LevelEvent> first_of_two_levels(const Level& first, const Level& second, double horizon,
-                                              double first_window, const long& samples);
+                                              double first_window, const long& samples, bool first_settles = false);
+
+/// Whether the gap rate Δx' = θ̇L − θ̇m of every free flight of `p` has at most two real zeros
+/// (counted with multiplicity): it then solves a third-order linear ODE with real characteristic
+/// roots (docs/design.md, "The event loop": the load's velocity decays by itself, θ̇L'' = −(FL/JL)θ̇L';
+/// with the output at the load the motor's velocity solves D(D + FL/JL)(D + Fm/Jm)θ̇m = 0, with it
+/// at the motor (D² + (Fm/Jm)D + K/Jm)θ̇m = 0 — real roots only for a motor damped at least
+/// critically).  A flight leaving a face has Δx'(0) = 0, so its gap turns at most once after t = 0.
+bool gap_rate_turns_at_most_once(const Parameters& p);
+
+/// Whether a flight whose gap turns at most once after t = 0 (gap_rate_turns_at_most_once, Δx'(0)
+/// = 0), leaving with Δx of sign `departure_sign` on (0, t1] (certified_clearance), can return to
+/// the face left (Δx = 0) before its first crossing of the opposite face's level Δx = L only when
+/// it leaves away from L: Δx is strictly monotone up to its turn t* (Δx' has at most one zero on
+/// (0, ∞), a simple one: two zeros there and the one at 0 would be three) and strictly monotone
+/// the other way after it.  Leaving toward L, it is nonzero on (0, t*]; after t* it moves back
+/// toward 0, so it can reach L after t* only from beyond L — already crossed before t*.  Hence
+/// a first crossing of L (not grazing) at t_c has t_c ≤ t* and Δx ≠ 0 on (0, t_c]: no return.
+inline bool no_return_before_opposite_face(int departure_sign, double opposite_face_change) {
+  return departure_sign != 0 && (departure_sign > 0) == (opposite_face_change > 0) && opposite_face_change != 0;
+}
 
 /// first_gap_event on the gap mode with `sample` any callable (double) → WitnessSample: the
 /// event loop's own flight, called directly by the certified search (certified_search.hpp).
+/// `turns_once`: the flight's exact gap change has Δx(0) = Δx'(0) = 0 and turns at most once
+/// after t = 0 (gap_rate_turns_at_most_once, and the flight starts with equal velocities): then
+/// the return to the face left is not searched before the opposite face's crossing (no_return_before).
 template <class F>
 std::optional<GapEvent> first_gap_event_with(const WitnessMode& gap_mode, const F& sample, double opposite_face_change,
-                                             double horizon, double position_scale) {
+                                             double horizon, double position_scale, bool turns_once = false) {
   // x(0): the searches' first point and the departure's start, evaluated once.  The return search
   // samples its horizon, the opposite face's crossing when it is searched up to one: that sample
   // is kept as the event's state (`watch`: the horizon of the return search last started).
@@ -97,14 +127,17 @@ std::optional<GapEvent> first_gap_event_with(const WitnessMode& gap_mode, const 
     if (only) return GapEvent{GapEventKind::OppositeFace, *only, 0, false, {}};
     return std::nullopt;
   }
-  const double clear = certified_clearance(gap_mode, x0, *t0, noise);
+  int sign = 0;
+  const double clear = certified_clearance(gap_mode, x0, *t0, noise, &sign);
   const auto back = [&](double lo, double hi) {
     watch = hi;
     at_watch.resize(0);
     return certified_crossing_after_departure(gap_mode, counted, *t0, std::max(clear, lo), hi);
   };
   const Level first{opposite, 0}, second{back, clear > *t0 ? std::min(clear, horizon) : *t0};
-  const std::optional<LevelEvent> event = first_of_two_levels(first, second, horizon, gap_mode.first_window, samples);
+  const bool first_settles = turns_once && clear > *t0 && no_return_before_opposite_face(sign, opposite_face_change);
+  const std::optional<LevelEvent> event =
+      first_of_two_levels(first, second, horizon, gap_mode.first_window, samples, first_settles);
   if (!event) return std::nullopt;
   if (event->second) return GapEvent{GapEventKind::FaceLeft, event->crossing, *t0, false, {}};
   const bool sampled_there = watch == event->crossing.t && at_watch.size() > 0;

@@ -502,9 +502,12 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   const auto at = [flight](double tau) { return flight.at(tau); };  // a copy: record() may keep it
   const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(constants_->time_unit, state_.dtheta_m))});
   const auto sample = [&flight](double tau) { return flight.gap_sample(tau); };
+  // Δx'(0) = 0 exactly: the separation line's closed form starts both bodies at one velocity.
+  const bool turns_once = constants_->gap_turns_once && (from_line || state_.dtheta_m == state_.dtheta_L);
   const auto event = start_gap_ ? detail::first_gap_event_inside_with(gap_mode_, sample, *start_gap_, state_.face,
                                                                       p_.backlash / 2, remaining)
-                                : detail::first_gap_event_with(gap_mode_, sample, -state_.face * p_.backlash, remaining, scale);
+                                : detail::first_gap_event_with(gap_mode_, sample, -state_.face * p_.backlash, remaining,
+                                                               scale, turns_once);
   start_gap_.reset();  // every later flight leaves a face
   if (o_.track_extremes) {
     const auto vector = [&flight](double tau) { return flight.vector(tau); };

@@ -45,7 +45,8 @@ RunConstants::RunConstants(const Parameters& p)
       torque(transmitted_torque(p)),
       time_unit(servo_time_unit(p)),
       contact_mode(contact_segment.A, contact_segment.c, torque.r, time_unit),
-      gap_mode(gap_witness_mode(free_segment, time_unit)) {
+      gap_mode(gap_witness_mode(free_segment, time_unit)),
+      gap_turns_once(gap_rate_turns_at_most_once(p)) {
   built.fetch_add(1, std::memory_order_relaxed);
 }
 

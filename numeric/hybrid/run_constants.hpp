@@ -29,6 +29,7 @@ struct RunConstants {
   const TransmittedTorque torque;
   const double time_unit;  ///< servo_time_unit(parameters)
   const WitnessMode contact_mode, gap_mode;  ///< Tc in contact; the gap θL − θm in flight
+  const bool gap_turns_once;  ///< gap_rate_turns_at_most_once(parameters) (gap_events.hpp)
 
  private:
   struct Velocities {
