@@ -176,32 +176,53 @@ double last_within(double first_guess, double t0, double bound, double growth, d
   return 0;
 }
 
-double certified_clearance(const WitnessMode& W, const SmallVector& x0, double t0, double noise) {
-  return detail::certified_clearance(W, x0, t0, noise, nullptr);
-}
+namespace {
 
-double detail::certified_clearance(const WitnessMode& W, const SmallVector& x0, double t0, double noise, int* sign) {
-  const StartRates r = start_rates(W, x0);
-  const double z0 = r.z0;
+// certified_clearance's judgement of the leading term of w at the start: w''(0) (order 2) or, on
+// the separation line, w'''(0) (order 3), resolved from the rounding and the noise; order 0 when
+// neither is.
+struct LeadingTerm {
+  int order = 0, sign = 0;
+};
+
+LeadingTerm leading_term(const WitnessMode& W, const StartRates& r, double t0, double noise) {
   const double second = std::fabs(r.second), third = std::fabs(r.third);
   // The computed w''(0) is within `rounding` of the exact one (a million times its ulps).
   const double rounding = kSampleNoise * W.norm_eA * (W.norm_A_plain * r.x_size + W.norm_c);
-  const double growth = std::max(0.0, W.mu_A);
-  if (second > 1e-12 * std::max(1.0, z0) && quadratic_resolved(second, third, W.time_unit)) {
-    // w'' leads (certified_departure's first case): |w(t) − w''(0)t²/2| ≤ sup|w'''| t³/6, so
-    // |w(t)| ≥ |w''(0)| t²/4 while t·sup|w'''| ≤ 1.5|w''(0)|, sup|w'''| ≤ ‖eA²D⁻¹‖₁ e^{μ⁺t} z0.
-    if (!(second > rounding) || !(second * t0 * t0 / 4 >= noise / 8)) return 0;
-    if (sign) *sign = r.second > 0 ? 1 : -1;
-    return last_within(1.5 * second / (W.norm_eA2 * z0), t0, W.norm_eA2, growth, z0, 1.5 * second);
+  if (second > 1e-12 * std::max(1.0, r.z0) && quadratic_resolved(second, third, W.time_unit)) {
+    if (!(second > rounding) || !(second * t0 * t0 / 4 >= noise / 8)) return {};
+    return {2, r.second > 0 ? 1 : -1};
   }
-  // w''' leads (the separation line, w''(0) = 0 up to rounding): |w(t) − w'''(0)t³/6| ≤
-  // |w''(0)| t²/2 + sup|w''''| t⁴/24, so |w(t)| ≥ |w'''(0)| t³/12 on [t0, t] when
-  // (|w''(0)| + rounding)/(2 t0) ≤ |w'''(0)|/24 and t·sup|w''''| ≤ |w'''(0)|, sup|w''''| ≤ ‖eA³D⁻¹‖₁ e^{μ⁺t} z0.
   if (!std::isfinite(third) || !(third > 0) || !((second + rounding) / (2 * t0) <= third / 24) ||
       !(third * t0 * t0 * t0 / 12 >= noise / 8))
-    return 0;
-  if (sign) *sign = r.third > 0 ? 1 : -1;
-  return last_within(third / (W.norm_eA3 * z0), t0, W.norm_eA3, growth, z0, third);
+    return {};
+  return {3, r.third > 0 ? 1 : -1};
+}
+
+}  // namespace
+
+double certified_clearance(const WitnessMode& W, const SmallVector& x0, double t0, double noise) {
+  const StartRates r = start_rates(W, x0);
+  const double z0 = r.z0;
+  const double second = std::fabs(r.second), third = std::fabs(r.third);
+  const double growth = std::max(0.0, W.mu_A);
+  switch (leading_term(W, r, t0, noise).order) {
+    case 2:
+      // w'' leads (certified_departure's first case; resolved: above its rounding, and
+      // |w''(0)| t0²/4 ≥ noise/8): |w(t) − w''(0)t²/2| ≤ sup|w'''| t³/6, so |w(t)| ≥ |w''(0)| t²/4
+      // while t·sup|w'''| ≤ 1.5|w''(0)|, sup|w'''| ≤ ‖eA²D⁻¹‖₁ e^{μ⁺t} z0.
+      return last_within(1.5 * second / (W.norm_eA2 * z0), t0, W.norm_eA2, growth, z0, 1.5 * second);
+    case 3:
+      // w''' leads (the separation line, w''(0) = 0 up to rounding): |w(t) − w'''(0)t³/6| ≤
+      // |w''(0)| t²/2 + sup|w''''| t⁴/24, so |w(t)| ≥ |w'''(0)| t³/12 on [t0, t] when
+      // (|w''(0)| + rounding)/(2 t0) ≤ |w'''(0)|/24 and t·sup|w''''| ≤ |w'''(0)|, sup|w''''| ≤ ‖eA³D⁻¹‖₁ e^{μ⁺t} z0.
+      return last_within(third / (W.norm_eA3 * z0), t0, W.norm_eA3, growth, z0, third);
+    default: return 0;
+  }
+}
+
+int detail::departure_sign(const WitnessMode& W, const SmallVector& x0, double t0, double noise) {
+  return leading_term(W, start_rates(W, x0), t0, noise).sign;
 }
 
 std::optional<double> certified_departure(const LinearWitness& witness, double noise) {

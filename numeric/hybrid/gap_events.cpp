@@ -46,14 +46,14 @@ namespace {
 
 // The reference's answer from the first level's whole search: the second searched up to its crossing.
 std::optional<LevelEvent> with_second(const std::optional<Crossing>& a, const Level& second, double horizon) {
-  const std::optional<Crossing> b = second.search(second.start, a ? a->t : horizon);
+  const std::optional<Crossing> b = second.search(second.start(), a ? a->t : horizon);
   if (b && (!a || b->t < a->t)) return LevelEvent{true, *b};
   if (a) return LevelEvent{false, *a};
   return std::nullopt;
 }
 
 std::optional<LevelEvent> sequential_search(const Level& first, const Level& second, double horizon) {
-  return with_second(first.search(first.start, horizon), second, horizon);
+  return with_second(first.search(first.start(), horizon), second, horizon);
 }
 
 // The first stretch of each level, searched as its whole search searches it (windows 0, 1, 2 of
@@ -70,14 +70,14 @@ struct Track {
   std::optional<Crossing> found;
 
   Track(const Level& l, double horizon_, double first_window_)
-      : level(l), horizon(horizon_), first_window(first_window_), window(first_window_), begin(l.start), end(l.start) {}
+      : level(l), horizon(horizon_), first_window(first_window_), window(first_window_), begin(l.start()), end(begin) {}
   bool exhausted() const { return found || end >= horizon; }
   // No crossing of this level on (start, x] (x ≤ horizon, or the horizon reached).
   bool clear_beyond(double x) const { return found ? found->t > x : (end >= x || end >= horizon); }
   // The whole search's windows from the start, its ends computed as first_crossing's search does,
   // up to the first one that ends at or after `t`, `count` of them at least: (begin, end].
   void windows_to(double t, int count) {
-    begin = end = level.start;
+    begin = end = level.start();
     window = first_window;
     for (int i = 0; end < horizon && (i < count || end < t); ++i) {
       begin = end;
@@ -91,7 +91,7 @@ struct Track {
     if (!started) {
       started = exact = true;
       windows_to(reach, windows);
-      found = level.search(level.start, end);
+      found = level.search(level.start(), end);
       if (found) windows_to(found->t, 1);  // the window that holds it
       return;
     }
@@ -105,7 +105,7 @@ struct Track {
   // there) when a window of its own found it; it must be the same crossing in the same window.
   std::optional<Crossing> whole() const {
     if (exact) return found;
-    const std::optional<Crossing> w = level.search(level.start, horizon);
+    const std::optional<Crossing> w = level.search(level.start(), horizon);
     if (!w || w->grazing || w->t > end || !(std::fabs(w->t - found->t) <= 1e-9 * found->t)) return std::nullopt;
     return w;
   }
@@ -151,10 +151,11 @@ Windowed windowed_search(Track& a, Track& b, const long& samples, bool first_set
 // —, else both levels window by window, and the sequential searches where they cannot settle.
 std::optional<LevelEvent> windowed_levels(const Level& first, const Level& second, double horizon, double first_window,
                                           const long& samples, bool first_settles) {
-  Track a(first, horizon, first_window), b(second, horizon, first_window);
+  Track a(first, horizon, first_window);
   a.advance(-INFINITY, kFirstStretchWindows);
   if (first_settles && a.found && !a.found->grazing) return LevelEvent{false, *a.found};
   if (a.exhausted()) return with_second(a.found, second, horizon);
+  Track b(second, horizon, first_window);
   const Windowed windowed = windowed_search(a, b, samples, first_settles);
   if (windowed.settled) return windowed.event;
   return sequential_search(first, second, horizon);

@@ -46,9 +46,10 @@ std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef
 std::optional<GapEvent> first_gap_event_inside(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
                                                double start_gap, int face, double half, double horizon);
 
-/// certified_clearance (first_crossing.hpp) that also writes, when its t1 > 0, the sign of w on
-/// (0, t1] (its leading term's, w''(0) or w'''(0)) to `sign`.
-double certified_clearance(const WitnessMode& mode, const SmallVector& x0, double t0, double noise, int* sign);
+/// The sign of w near the start (its leading term's, w''(0) or w'''(0), on (0, t0]) when
+/// certified_clearance judges that term resolved from rounding and noise (first_crossing.hpp);
+/// 0 when it does not.
+int departure_sign(const WitnessMode& mode, const SmallVector& x0, double t0, double noise);
 
 /// The gap witness's mode: e = θL − θm on the free segment.
 WitnessMode gap_witness_mode(const LinearSegment& free_segment, double time_unit);
@@ -58,8 +59,10 @@ WitnessMode gap_witness_mode(const LinearSegment& free_segment, double time_unit
 using SpanSearch = FunctionRef<std::optional<Crossing>(double, double)>;
 
 struct Level {
-  SpanSearch search;  ///< the certified first crossing in (lo, hi]; search(start, T) is the level's whole search
-  double start;       ///< no crossing on (0, start] (a departure certified clear up to there)
+  SpanSearch search;  ///< the certified first crossing in (lo, hi]; search(start(), T) is the level's whole search
+  /// no crossing on (0, start()] (a departure certified clear up to there): asked only when the
+  /// level is searched (a clearance is not computed for a level that need not be)
+  FunctionRef<double()> start;
 };
 
 struct LevelEvent {
@@ -127,15 +130,21 @@ std::optional<GapEvent> first_gap_event_with(const WitnessMode& gap_mode, const 
     if (only) return GapEvent{GapEventKind::OppositeFace, *only, 0, false, {}};
     return std::nullopt;
   }
-  int sign = 0;
-  const double clear = certified_clearance(gap_mode, x0, *t0, noise, &sign);
+  double clear = NAN;  // certified_clearance, computed when the return is searched
+  const auto cleared = [&] {
+    if (std::isnan(clear)) clear = certified_clearance(gap_mode, x0, *t0, noise);
+    return clear;
+  };
   const auto back = [&](double lo, double hi) {
     watch = hi;
     at_watch.resize(0);
-    return certified_crossing_after_departure(gap_mode, counted, *t0, std::max(clear, lo), hi);
+    return certified_crossing_after_departure(gap_mode, counted, *t0, std::max(cleared(), lo), hi);
   };
-  const Level first{opposite, 0}, second{back, clear > *t0 ? std::min(clear, horizon) : *t0};
-  const bool first_settles = turns_once && clear > *t0 && no_return_before_opposite_face(sign, opposite_face_change);
+  const auto zero = [] { return 0.0; };
+  const auto back_start = [&] { return cleared() > *t0 ? std::min(clear, horizon) : *t0; };
+  const Level first{opposite, zero}, second{back, back_start};
+  const bool first_settles =
+      turns_once && no_return_before_opposite_face(departure_sign(gap_mode, x0, *t0, noise), opposite_face_change);
   const std::optional<LevelEvent> event =
       first_of_two_levels(first, second, horizon, gap_mode.first_window, samples, first_settles);
   if (!event) return std::nullopt;
@@ -157,7 +166,8 @@ std::optional<GapEvent> first_gap_event_inside_with(const WitnessMode& gap_mode,
   const auto opposite = [&](double lo, double hi) {
     return certified_first_crossing(gap_mode, counted, -face * half - start_gap, lo, hi);
   };
-  const Level first{same, 0}, second{opposite, 0};
+  const auto zero = [] { return 0.0; };
+  const Level first{same, zero}, second{opposite, zero};
   const std::optional<LevelEvent> event = first_of_two_levels(first, second, horizon, gap_mode.first_window, samples);
   if (!event) return std::nullopt;
   if (event->second) return GapEvent{GapEventKind::OppositeFace, event->crossing, 0, true, {}};
