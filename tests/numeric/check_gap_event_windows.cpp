@@ -16,6 +16,7 @@
 #include "backlash/numeric/validated_family.hpp"
 #include "hybrid/gap_events.hpp"
 #include "hybrid/linear_flight.hpp"
+#include "sequential_gap_event.hpp"
 #include "thesis_cases_two_to_four.hpp"
 
 #include <gtest/gtest.h>
@@ -36,22 +37,8 @@ using detail::GapEventKind;
 // The thesis's cases II–IV with the load's friction FL (θR = 1, as the case files).
 Parameters thesis_case(int number, double FL) { return backlash::testing::thesis_case_two_to_four(number, FL, 1); }
 
-// The code before the windows (gap_events.cpp at main): the opposite face over the whole horizon,
-// then the return to the face left up to it.
-std::optional<GapEvent> sequential_event(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample,
-                                         double opposite_face_change, double horizon, double position_scale) {
-  const std::optional<Crossing> opposite = first_crossing(mode, sample, opposite_face_change, 0, horizon);
-  std::optional<Crossing> back;
-  const double noise = 1e-10 * std::max(1.0, position_scale);
-  const SmallVector x0 = sample(0).x;
-  const std::optional<double> t0 = certified_departure(mode, x0, noise);
-  if (t0)
-    back = first_crossing_after_departure(mode, sample, *t0, certified_clearance(mode, x0, *t0, noise),
-                                          opposite ? opposite->t : horizon);
-  if (back && (!opposite || back->t < opposite->t)) return GapEvent{GapEventKind::FaceLeft, *back, *t0, false, {}};
-  if (opposite) return GapEvent{GapEventKind::OppositeFace, *opposite, 0, false, {}};
-  return std::nullopt;
-}
+using backlash::testing::CountedFlight;
+using backlash::testing::sequential_event;
 
 // The same from inside the backlash: the face σ over the whole horizon, then the other face up to it.
 std::optional<GapEvent> sequential_event_inside(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample,
@@ -81,17 +68,6 @@ void expect_same(const std::optional<GapEvent>& windowed, const std::optional<Ga
   EXPECT_EQ(windowed->departure, sequential->departure) << label;
   EXPECT_EQ(windowed->from_inside, sequential->from_inside) << label;
 }
-
-// A free flight from x0 in closed form (LinearFlight, the flight after a bounce), its samples counted.
-struct CountedFlight {
-  LinearFlight flight;
-  mutable long samples = 0;
-  WitnessSample operator()(double t) const {
-    ++samples;
-    const SmallVector change = flight.change(t);
-    return {flight.state(t), change(2) - change(0)};
-  }
-};
 
 // A flight leaving the face σ after a bounce: both bodies at one velocity, the gap at σ b/2, its
 // relative acceleration away from the face (toward the opposite one).  Nothing when the draw

@@ -12,6 +12,7 @@
 #include "backlash/numeric/segment_dynamics.hpp"
 #include "hybrid/gap_events.hpp"
 #include "hybrid/linear_flight.hpp"
+#include "sequential_gap_event.hpp"
 
 #include <gtest/gtest.h>
 
@@ -62,30 +63,8 @@ std::optional<SmallVector> leaving_flight(const Parameters& p, std::mt19937_64& 
   return x;
 }
 
-struct Sampled {
-  LinearFlight flight;
-  mutable long samples = 0;
-  WitnessSample operator()(double t) const {
-    ++samples;
-    const SmallVector change = flight.change(t);
-    return {flight.state(t), change(2) - change(0)};
-  }
-};
-
-// The reference: the opposite face over the horizon, then the return from the departure up to it.
-std::optional<GapEvent> one_after_the_other(const WitnessMode& mode, const Sampled& sample, double level, double horizon,
-                                            double noise) {
-  const std::optional<Crossing> opposite = first_crossing(mode, sample, level, 0, horizon);
-  const SmallVector x0 = sample(0).x;
-  const std::optional<double> t0 = certified_departure(mode, x0, noise);
-  std::optional<Crossing> back;
-  if (t0)
-    back = first_crossing_after_departure(mode, sample, *t0, certified_clearance(mode, x0, *t0, noise),
-                                          opposite ? opposite->t : horizon);
-  if (back && (!opposite || back->t < opposite->t)) return GapEvent{GapEventKind::FaceLeft, *back, *t0, false, {}};
-  if (opposite) return GapEvent{GapEventKind::OppositeFace, *opposite, 0, false, {}};
-  return std::nullopt;
-}
+using backlash::testing::CountedFlight;
+using backlash::testing::sequential_event;
 
 bool same_event(const std::optional<GapEvent>& a, const std::optional<GapEvent>& b) {
   if (a.has_value() != b.has_value()) return false;
@@ -132,9 +111,9 @@ void run_flights(int kind, bool forced, int sets, Tally& tally) {
       if (!x0) continue;
       const double level = -face * p.backlash;
       const double scale = std::max({1.0, std::fabs((*x0)(0)), std::fabs((*x0)(2))});
-      const Sampled reference_sample{LinearFlight(free_mode_segment(p), *x0)};
-      const auto reference = one_after_the_other(mode, reference_sample, level, horizon, 1e-10 * scale);
-      const Sampled sample{LinearFlight(free_mode_segment(p), *x0)};
+      const CountedFlight reference_sample{LinearFlight(free_mode_segment(p), *x0)};
+      const auto reference = sequential_event(mode, reference_sample, level, horizon, scale);
+      const CountedFlight sample{LinearFlight(free_mode_segment(p), *x0)};
       const auto event = detail::first_gap_event_with(mode, sample, level, horizon, scale, kind != 2 || forced);
       ++tally.flights;
       tally.samples_once += sample.samples;
