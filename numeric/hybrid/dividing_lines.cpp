@@ -113,8 +113,10 @@ DividingLinePoint dividing_line_point(const ValidatedEvaluator& evaluator, doubl
   const double scale = std::max({1.0, std::fabs(p.theta_R), std::fabs(evaluator.cot_phi() * v0)});
   std::optional<detail::GapEvent> event;
   try {
+    // From the separation line: both bodies at v0, Δx'(0) = 0 exactly (gap_events.hpp, turns_once).
     event = detail::first_gap_event(free_mode_segment(p), gap.state, gap.value, std::copysign(p.backlash, v0),
-                                    horizon_of(p, options), scale, servo_time_unit(p));
+                                    horizon_of(p, options), scale, servo_time_unit(p),
+                                    detail::gap_rate_turns_at_most_once(p));
   } catch (const SearchBudgetExhausted&) {
     point.status = RecombinationStatus::Unresolved;
     return point;

@@ -185,8 +185,9 @@ bool gap_rate_turns_at_most_once(const Parameters& p) {
 }
 
 std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
-                                        double opposite_face_change, double horizon, double position_scale) {
-  return first_gap_event_with(gap_mode, sample, opposite_face_change, horizon, position_scale);
+                                        double opposite_face_change, double horizon, double position_scale,
+                                        bool turns_once) {
+  return first_gap_event_with(gap_mode, sample, opposite_face_change, horizon, position_scale, turns_once);
 }
 
 std::optional<GapEvent> first_gap_event_inside(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
@@ -196,9 +197,10 @@ std::optional<GapEvent> first_gap_event_inside(const WitnessMode& gap_mode, Func
 
 std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
                                         std::function<double(double)> gap_change, double opposite_face_change,
-                                        double horizon, double position_scale, double time_unit) {
+                                        double horizon, double position_scale, double time_unit, bool turns_once) {
   const auto sample = [&state, &gap_change](double t) { return WitnessSample{state(t), gap_change(t)}; };
-  return first_gap_event(gap_witness_mode(free_segment, time_unit), sample, opposite_face_change, horizon, position_scale);
+  return first_gap_event(gap_witness_mode(free_segment, time_unit), sample, opposite_face_change, horizon, position_scale,
+                         turns_once);
 }
 
 }  // namespace backlash::numeric::detail

@@ -29,15 +29,18 @@ LinearWitness gap_change_witness(const LinearSegment& free_segment, std::functio
 /// A free flight whose gap change Δx(t) = x(t) − x(0) starts at 0 with zero
 /// relative velocity.  `state` gives x(t) = (θm, θ̇m, θL, θ̇L) (any frame),
 /// `gap_change` gives Δx(t) directly.  The first time Δx reaches
-/// `opposite_face_change` (±b) or returns to 0 (certified departure first).
+/// `opposite_face_change` (±b) or returns to 0 (certified departure first).  `turns_once` as
+/// first_gap_event_with's.
 std::optional<GapEvent> first_gap_event(const LinearSegment& free_segment, std::function<SmallVector(double)> state,
                                         std::function<double(double)> gap_change, double opposite_face_change,
-                                        double horizon, double position_scale, double time_unit = 1);
+                                        double horizon, double position_scale, double time_unit = 1,
+                                        bool turns_once = false);
 
 /// The same on the free mode's gap witness built once (`gap_mode`: e = θL − θm on the free
 /// segment), `sample(t)` giving x(t) and Δx(t) from one closed-form evaluation.
 std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
-                                        double opposite_face_change, double horizon, double position_scale);
+                                        double opposite_face_change, double horizon, double position_scale,
+                                        bool turns_once = false);
 
 /// A free flight that starts strictly inside the backlash, at the gap x(0) = `start_gap`
 /// (|x(0)| < b/2 = `half`): the first arrival of x at a face — Δx = σ b/2 − x(0) (FaceLeft: the
