@@ -89,6 +89,37 @@ double contact_torque(const Parameters& p, const Effects& e, const Mode& m, cons
 
 // ------------------------------------------------------------------ the generic flow (mesh modes)
 
+// The test ‖V‖∞·‖V⁻¹‖∞ ≤ limit with each row sum of moduli |z| = hypot(re, im) bracketed first
+// without hypot, max(|re|, |im|) ≤ |z| ≤ |re| + |im| (a margin of 1e-6 relative covers the
+// brackets' own rounding): when the brackets of the product decide the test, that is the exact
+// test's answer; only otherwise (or with an entry not finite) are the moduli formed.
+bool well_conditioned_basis(const Eigen::MatrixXcd& vectors, const Eigen::MatrixXcd& inverse, double limit) {
+  bool finite = true;
+  const auto brackets = [&finite](const Eigen::MatrixXcd& X, double& low, double& high) {
+    low = high = 0;
+    for (Eigen::Index i = 0; i < X.rows(); ++i) {
+      double row_low = 0, row_high = 0;
+      for (Eigen::Index j = 0; j < X.cols(); ++j) {
+        const double re = std::fabs(X(i, j).real()), im = std::fabs(X(i, j).imag());
+        row_low += std::max(re, im);
+        row_high += re + im;
+      }
+      finite = finite && std::isfinite(row_high);
+      low = std::max(low, row_low);
+      high = std::max(high, row_high);
+    }
+  };
+  double low_v = 0, high_v = 0, low_i = 0, high_i = 0;
+  brackets(vectors, low_v, high_v);
+  brackets(inverse, low_i, high_i);
+  if (finite && high_v * high_i * (1 + 1e-6) <= limit) return true;
+  if (finite && low_v * low_i * (1 - 1e-6) > limit) return false;
+  const double condition =
+      vectors.cwiseAbs().rowwise().sum().maxCoeff() * inverse.cwiseAbs().rowwise().sum().maxCoeff();
+  return std::isfinite(condition) && condition <= limit;
+}
+
+
 // z̃(τ) = e^{Mτ} z̃0 for the augmented M = [[A, c], [0, 0]]: by the eigen-decomposition of M when
 // it is diagonalisable with a well-conditioned basis (the generic mesh mode: two complex pairs
 // and the augmentation's 0), else by Eigen's Padé exponential at each τ.
@@ -147,7 +178,7 @@ struct ModeFlow::Generic {
       const Eigen::MatrixXcd vectors = solver.eigenvectors();
       Eigen::PartialPivLU<Eigen::MatrixXcd> lu(vectors);
       const Eigen::MatrixXcd inverse = lu.inverse();
-      if (well_conditioned(vectors, inverse)) {
+      if (well_conditioned_basis(vectors, inverse, 1e7)) {
         d.V.topLeftCorner(m, m) = vectors;
         d.inverse.topLeftCorner(m, m) = inverse;
         d.lambda.head(m) = solver.eigenvalues();
@@ -155,35 +186,6 @@ struct ModeFlow::Generic {
       }
     }
     return d;
-  }
-
-  // ‖V‖∞·‖V⁻¹‖∞ ≤ 1e7 (the basis is well conditioned), each row sum of moduli |z| = hypot(re, im)
-  // bracketed first without hypot: max(|re|, |im|) ≤ |z| ≤ |re| + |im|.  When the brackets of the
-  // product decide the test it is the exact test's answer; only otherwise are the moduli formed.
-  static bool well_conditioned(const Eigen::MatrixXcd& vectors, const Eigen::MatrixXcd& inverse) {
-    constexpr double limit = 1e7;
-    const auto brackets = [](const Eigen::MatrixXcd& X, double& low, double& high) {
-      low = high = 0;
-      for (Eigen::Index i = 0; i < X.rows(); ++i) {
-        double row_low = 0, row_high = 0;
-        for (Eigen::Index j = 0; j < X.cols(); ++j) {
-          const double re = std::fabs(X(i, j).real()), im = std::fabs(X(i, j).imag());
-          row_low += std::max(re, im);
-          row_high += re + im;
-        }
-        low = std::max(low, row_low);
-        high = std::max(high, row_high);
-      }
-    };
-    double low_v, high_v, low_i, high_i;
-    brackets(vectors, low_v, high_v);
-    brackets(inverse, low_i, high_i);
-    // A margin of 1e-6 relative covers the brackets' own rounding.
-    if (std::isfinite(high_v * high_i) && high_v * high_i * (1 + 1e-6) <= limit) return true;
-    if (low_v * low_i * (1 - 1e-6) > limit) return false;
-    const double condition =
-        vectors.cwiseAbs().rowwise().sum().maxCoeff() * inverse.cwiseAbs().rowwise().sum().maxCoeff();
-    return std::isfinite(condition) && condition <= limit;
   }
 
   Generic(const LinearSegment& s, const SmallVector& start) : n(static_cast<int>(s.A.rows())) {
