@@ -150,26 +150,11 @@ bool spurious_separation(const Parameters& p, const ModeFlow& flow, double tau) 
   return std::fabs(z(0)) <= noise && std::fabs(z(1)) <= noise * std::sqrt(p.K / (p.Jm + p.JL));
 }
 
-// A fingerprint of (A, e) that equal matrices share (== compares values: −0 is taken as +0, and
-// NaN never matches anyway): the sizes and each entry's bits, mixed (FNV-1a's multiplier).
-std::uint64_t fingerprint(const SmallMatrix& A, const SmallRow& e) {
-  std::uint64_t h = static_cast<std::uint64_t>(A.rows() * 8 + A.cols()) * 8 + static_cast<std::uint64_t>(e.size());
-  const auto mix = [&h](double v) {
-    v += 0.0;  // −0 + 0 = +0
-    std::uint64_t bits;
-    std::memcpy(&bits, &v, sizeof bits);
-    h = (h ^ bits) * 0x100000001b3ULL;
-  };
-  for (Eigen::Index i = 0; i < A.size(); ++i) mix(A.data()[i]);
-  for (Eigen::Index i = 0; i < e.size(); ++i) mix(e(i));
-  return h;
-}
-
 }  // namespace
 
 // Only c, eᵀc, eᵀA c and eᵀA² c depend on the forcing c (which moves with the start: the drive
 // folded in): WitnessMode::set_forcing; the others (eᵀA^k, the balancing, μ∞, the norms) come
-// from A and e alone.  Exact comparison of A and e (after their fingerprint).  Building the
+// from A and e alone.  Exact comparison of A and e.  Building the
 // constants per search was a third of a closed-form segment's cost (issue 19).  The entry kept
 // for (A, e) is given the forcing c and returned as it is.  The least recently used entry is the
 // one replaced, so an entry stays where it is (and keeps its forcing) for the next capacity − 1
@@ -179,7 +164,6 @@ const WitnessMode& detail::kept_witness_mode(const SmallMatrix& A, const SmallVe
   struct Entry {
     WitnessMode mode;
     std::uint64_t used;
-    std::uint64_t print;  // fingerprint(A, e): entries with another one are passed over unread
   };
   thread_local std::vector<Entry> cache = [] {
     std::vector<Entry> v;
@@ -189,16 +173,15 @@ const WitnessMode& detail::kept_witness_mode(const SmallMatrix& A, const SmallVe
   thread_local std::uint64_t clock = 0;
   ++clock;
   const auto same = [](const auto& x, const auto& y) { return x.rows() == y.rows() && x.cols() == y.cols() && x == y; };
-  const std::uint64_t print = fingerprint(A, e);
   for (Entry& entry : cache) {
-    if (entry.print != print || !same(entry.mode.e, e) || !same(entry.mode.A, A)) continue;
+    if (!same(entry.mode.e, e) || !same(entry.mode.A, A)) continue;
     entry.mode.set_forcing(c);
     entry.used = clock;
     return entry.mode;
   }
-  if (cache.size() < capacity) return cache.push_back({WitnessMode(A, c, e), clock, print}), cache.back().mode;
+  if (cache.size() < capacity) return cache.push_back({WitnessMode(A, c, e), clock}), cache.back().mode;
   Entry& oldest = *std::min_element(cache.begin(), cache.end(), [](const Entry& a, const Entry& b) { return a.used < b.used; });
-  oldest = {WitnessMode(A, c, e), clock, print};
+  oldest = {WitnessMode(A, c, e), clock};
   return oldest.mode;
 }
 
