@@ -50,17 +50,16 @@ numeric::Effects compliance() {
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
-}  // namespace
-
-TEST(EffectsEngineSearches, compliance_flow_is_the_augmented_exponential) {
+// Case V with compliance(): `check(mode, flow)` on each mesh mode's flow from `trials` random starts
+// (the teeth overlapping on its face by up to 1e-3 rad).
+template <class Check>
+void for_mesh_flows(std::mt19937& random, int trials, const Check& check) {
   const numeric::Parameters p = numeric::parameters_of(model::load_case("V"));
   const numeric::Effects e = compliance();
-  std::mt19937 random(19);
   std::uniform_real_distribution<double> unit(-1, 1);
-  int checked = 0;
   for (const numeric::Mode& m : numeric::reachable_modes(p, e)) {
     if (m.kind != numeric::ModeKind::Mesh) continue;
-    for (int trial = 0; trial < 20; ++trial) {
+    for (int trial = 0; trial < trials; ++trial) {
       numeric::HybridState start;
       start.in_contact = true;
       start.face = m.face;
@@ -68,24 +67,33 @@ TEST(EffectsEngineSearches, compliance_flow_is_the_augmented_exponential) {
       start.theta_L = start.theta_m + m.face * (p.backlash / 2 + 1e-3 * std::fabs(unit(random)));
       start.dtheta_m = unit(random);
       start.dtheta_L = unit(random);
-      const numeric::ModeFlow flow(p, e, m, start);
-      ASSERT_FALSE(flow.uses_matrix_exponential()) << m.describe();
-      const int n = static_cast<int>(flow.segment().A.rows());
-      Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n + 1, n + 1);
-      M.topLeftCorner(n, n) = flow.segment().A;
-      M.block(0, n, n, 1) = flow.segment().c;
-      Eigen::VectorXd z0(n + 1);
-      z0.head(n) = flow.local_start();
-      z0(n) = 1;
-      for (double tau : {1e-3, 0.05, 0.4, 2.0}) {
-        const Eigen::VectorXd reference = ((M * tau).exp() * z0).head(n);
-        const numeric::SmallVector z = flow.local(tau);
-        const double scale = std::max(1.0, reference.cwiseAbs().maxCoeff());
-        EXPECT_LE((z - reference).cwiseAbs().maxCoeff(), 1e-12 * scale) << m.describe() << ", tau " << tau;
-        ++checked;
-      }
+      check(m, numeric::ModeFlow(p, e, m, start));
     }
   }
+}
+
+}  // namespace
+
+TEST(EffectsEngineSearches, compliance_flow_is_the_augmented_exponential) {
+  std::mt19937 random(19);
+  int checked = 0;
+  for_mesh_flows(random, 20, [&checked](const numeric::Mode& m, const numeric::ModeFlow& flow) {
+    ASSERT_FALSE(flow.uses_matrix_exponential()) << m.describe();
+    const int n = static_cast<int>(flow.segment().A.rows());
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n + 1, n + 1);
+    M.topLeftCorner(n, n) = flow.segment().A;
+    M.block(0, n, n, 1) = flow.segment().c;
+    Eigen::VectorXd z0(n + 1);
+    z0.head(n) = flow.local_start();
+    z0(n) = 1;
+    for (double tau : {1e-3, 0.05, 0.4, 2.0}) {
+      const Eigen::VectorXd reference = ((M * tau).exp() * z0).head(n);
+      const numeric::SmallVector z = flow.local(tau);
+      const double scale = std::max(1.0, reference.cwiseAbs().maxCoeff());
+      EXPECT_LE((z - reference).cwiseAbs().maxCoeff(), 1e-12 * scale) << m.describe() << ", tau " << tau;
+      ++checked;
+    }
+  });
   EXPECT_GT(checked, 0);
 }
 
@@ -157,44 +165,31 @@ TEST(EffectsEngineSearches, check_conditioning_decided_as_by_the_moduli) {
 }
 
 TEST(EffectsEngineSearches, check_mesh_bound_holds) {
-  const numeric::Parameters p = numeric::parameters_of(model::load_case("V"));
-  const numeric::Effects e = compliance();
-  std::mt19937 random(23);
+  std::mt19937 random(23), rows(29);
   std::uniform_real_distribution<double> unit(-1, 1);
   int checked = 0;
-  for (const numeric::Mode& m : numeric::reachable_modes(p, e)) {
-    if (m.kind != numeric::ModeKind::Mesh) continue;
-    for (int trial = 0; trial < 10; ++trial) {
-      numeric::HybridState start;
-      start.in_contact = true;
-      start.face = m.face;
-      start.theta_m = 0.6 + 0.3 * unit(random);
-      start.theta_L = start.theta_m + m.face * (p.backlash / 2 + 1e-3 * std::fabs(unit(random)));
-      start.dtheta_m = unit(random);
-      start.dtheta_L = unit(random);
-      const numeric::ModeFlow flow(p, e, m, start);
-      const numeric::SmallMatrix& A = flow.segment().A;
-      numeric::SmallRow row(A.rows());
-      for (Eigen::Index i = 0; i < row.size(); ++i) row(i) = unit(random);
-      const auto bound = flow.derivative_bound(row, 3);
-      ASSERT_TRUE(static_cast<bool>(bound)) << m.describe();
-      const numeric::SmallRow third = row * A * A;  // w''' = e A² z'
-      for (double a : {0.0, 0.01, 0.3}) {
-        const double b = a + 0.05 * (1 + std::fabs(unit(random)));
-        const double M3 = bound(a, b);
-        double largest = 0;
-        for (int k = 0; k <= 64; ++k) {
-          const numeric::SmallVector z = flow.local(a + (b - a) * k / 64);
-          const numeric::SmallVector rate = A * z + flow.segment().c;
-          double w3 = 0;
-          for (Eigen::Index i = 0; i < rate.size(); ++i) w3 += third(i) * rate(i);
-          largest = std::max(largest, std::fabs(w3));
-        }
-        EXPECT_GE(M3, largest * (1 - 1e-9)) << m.describe() << " on [" << a << ", " << b << "]";
-        EXPECT_LE(M3, 1e6 * largest + 1e-6) << m.describe() << ": far above |w'''|, every interval would be halved";
-        ++checked;
+  for_mesh_flows(random, 10, [&](const numeric::Mode& m, const numeric::ModeFlow& flow) {
+    const numeric::SmallMatrix& A = flow.segment().A;
+    numeric::SmallRow row(A.rows());
+    for (Eigen::Index i = 0; i < row.size(); ++i) row(i) = unit(rows);
+    const auto bound = flow.derivative_bound(row, 3);
+    ASSERT_TRUE(static_cast<bool>(bound)) << m.describe();
+    const numeric::SmallRow third = row * A * A;  // w''' = e A² z'
+    for (double a : {0.0, 0.01, 0.3}) {
+      const double b = a + 0.05 * (1 + std::fabs(unit(rows)));
+      const double M3 = bound(a, b);
+      double largest = 0;
+      for (int k = 0; k <= 64; ++k) {
+        const numeric::SmallVector z = flow.local(a + (b - a) * k / 64);
+        const numeric::SmallVector rate = A * z + flow.segment().c;
+        double w3 = 0;
+        for (Eigen::Index i = 0; i < rate.size(); ++i) w3 += third(i) * rate(i);
+        largest = std::max(largest, std::fabs(w3));
       }
+      EXPECT_GE(M3, largest * (1 - 1e-9)) << m.describe() << " on [" << a << ", " << b << "]";
+      EXPECT_LE(M3, 1e6 * largest + 1e-6) << m.describe() << ": far above |w'''|, every interval would be halved";
+      ++checked;
     }
-  }
+  });
   EXPECT_GT(checked, 0);
 }
