@@ -89,6 +89,37 @@ double contact_torque(const Parameters& p, const Effects& e, const Mode& m, cons
 
 // ------------------------------------------------------------------ the generic flow (mesh modes)
 
+// The test ‖V‖∞·‖V⁻¹‖∞ ≤ limit with each row sum of moduli |z| = hypot(re, im) bracketed first
+// without hypot, max(|re|, |im|) ≤ |z| ≤ |re| + |im| (a margin of 1e-6 relative covers the
+// brackets' own rounding): when the brackets of the product decide the test, that is the exact
+// test's answer; only otherwise (or with an entry not finite) are the moduli formed.
+bool well_conditioned_basis(const Eigen::MatrixXcd& vectors, const Eigen::MatrixXcd& inverse, double limit) {
+  bool finite = true;
+  const auto brackets = [&finite](const Eigen::MatrixXcd& X, double& low, double& high) {
+    low = high = 0;
+    for (Eigen::Index i = 0; i < X.rows(); ++i) {
+      double row_low = 0, row_high = 0;
+      for (Eigen::Index j = 0; j < X.cols(); ++j) {
+        const double re = std::fabs(X(i, j).real()), im = std::fabs(X(i, j).imag());
+        row_low += std::max(re, im);
+        row_high += re + im;
+      }
+      finite = finite && std::isfinite(row_high);
+      low = std::max(low, row_low);
+      high = std::max(high, row_high);
+    }
+  };
+  double low_v = 0, high_v = 0, low_i = 0, high_i = 0;
+  brackets(vectors, low_v, high_v);
+  brackets(inverse, low_i, high_i);
+  if (finite && high_v * high_i * (1 + 1e-6) <= limit) return true;
+  if (finite && low_v * low_i * (1 - 1e-6) > limit) return false;
+  const double condition =
+      vectors.cwiseAbs().rowwise().sum().maxCoeff() * inverse.cwiseAbs().rowwise().sum().maxCoeff();
+  return std::isfinite(condition) && condition <= limit;
+}
+
+
 // z̃(τ) = e^{Mτ} z̃0 for the augmented M = [[A, c], [0, 0]]: by the eigen-decomposition of M when
 // it is diagonalisable with a well-conditioned basis (the generic mesh mode: two complex pairs
 // and the augmentation's 0), else by Eigen's Padé exponential at each τ.
@@ -102,6 +133,9 @@ struct ModeFlow::Generic {
   bool diagonal = false;
   ComplexVector5 lambda, q;
   ComplexMatrix5 V;
+  std::array<double, 5> lambda_cubed{};  // |λ_j|³ (pow(|λ_j|, 3), the same bits), for every witness's bound
+
+  double modulus_cubed(int j) const { return lambda_cubed[static_cast<std::size_t>(j)]; }
 
   // The eigen-decomposition of an augmented matrix, kept per thread for the last few matrices:
   // a mesh mode is entered again and again with the same matrix (the gap constant snapped to
@@ -115,13 +149,27 @@ struct ModeFlow::Generic {
     ComplexMatrix5 V, inverse;
   };
   static const Decomposition& decomposition(const Matrix5& M, int m) {
-    thread_local std::vector<Decomposition> cache;
+    constexpr std::size_t capacity = 16;
+    thread_local std::vector<Decomposition> cache = [] {
+      std::vector<Decomposition> v;
+      v.reserve(capacity);
+      return v;
+    }();
     thread_local std::size_t next = 0;
     for (const Decomposition& d : cache)
       if (d.m == m && d.M == M) return d;
-    Decomposition d;
+    // Computed in its slot (a new one, else the oldest in turn), not copied there.
+    Decomposition* slot = nullptr;
+    if (cache.size() < capacity) {
+      slot = &cache.emplace_back();
+    } else {
+      slot = &cache[next];
+      next = (next + 1) % capacity;
+    }
+    Decomposition& d = *slot;
     d.M = M;
     d.m = m;
+    d.diagonal = false;
     d.lambda = ComplexVector5::Zero();
     d.V = ComplexMatrix5::Zero();
     d.inverse = ComplexMatrix5::Zero();
@@ -130,24 +178,14 @@ struct ModeFlow::Generic {
       const Eigen::MatrixXcd vectors = solver.eigenvectors();
       Eigen::PartialPivLU<Eigen::MatrixXcd> lu(vectors);
       const Eigen::MatrixXcd inverse = lu.inverse();
-      const double condition =
-          vectors.cwiseAbs().rowwise().sum().maxCoeff() * inverse.cwiseAbs().rowwise().sum().maxCoeff();
-      if (std::isfinite(condition) && condition <= 1e7) {
+      if (well_conditioned_basis(vectors, inverse, 1e7)) {
         d.V.topLeftCorner(m, m) = vectors;
         d.inverse.topLeftCorner(m, m) = inverse;
         d.lambda.head(m) = solver.eigenvalues();
         d.diagonal = true;
       }
     }
-    constexpr std::size_t capacity = 16;
-    if (cache.size() < capacity) {
-      cache.push_back(std::move(d));
-      return cache.back();
-    }
-    cache[next] = std::move(d);
-    const std::size_t at = next;
-    next = (next + 1) % capacity;
-    return cache[at];
+    return d;
   }
 
   Generic(const LinearSegment& s, const SmallVector& start) : n(static_cast<int>(s.A.rows())) {
@@ -162,6 +200,7 @@ struct ModeFlow::Generic {
     lambda = d.lambda;
     q = ComplexVector5::Zero();
     q.head(m) = d.inverse.topLeftCorner(m, m) * z0.head(m).cast<std::complex<double>>();
+    for (int j = 0; j < m; ++j) lambda_cubed[static_cast<std::size_t>(j)] = std::pow(std::abs(lambda(j)), 3);
     diagonal = true;
   }
 
@@ -492,16 +531,24 @@ std::function<double(double, double)> ModeFlow::derivative_bound(const SmallRow&
   if (!generic_) return {};
   const Generic& g = *generic_;
   const int m = g.n + 1;
-  std::vector<std::pair<double, double>> terms;  // (|c_j||λ_j|^order, Re λ_j)
+  // (|c_j||λ_j|^order, Re λ_j), at most m = 5 terms: held by value, no vector per witness.
+  std::array<std::pair<double, double>, 5> terms{};
+  int count = 0;
   for (int j = 0; j < m; ++j) {
     std::complex<double> c = 0;
     for (int i = 0; i < g.n; ++i) c += row(i) * g.V(i, j);
-    const double size = std::abs(c * g.q(j)) * std::pow(std::abs(g.lambda(j)), order);
-    if (size > 0) terms.push_back({size, g.lambda(j).real()});
+    const double power = order == 3 ? g.modulus_cubed(j) : std::pow(std::abs(g.lambda(j)), order);
+    const double size = std::abs(c * g.q(j)) * power;
+    if (size > 0) terms[count++] = {size, g.lambda(j).real()};
   }
-  return [terms](double a, double b) {
-    double bound = 0;
-    for (const auto& [size, rate] : terms) bound += size * std::exp(rate * (rate > 0 ? b : a));
+  // A conjugate pair's two terms share Re λ: its exponential is formed once (the same bits).
+  return [terms, count](double a, double b) {
+    double bound = 0, last_rate = NAN, growth = 0;
+    for (int k = 0; k < count; ++k) {
+      const auto& [size, rate] = terms[k];
+      if (!(rate == last_rate)) growth = std::exp(rate * (rate > 0 ? b : a)), last_rate = rate;
+      bound += size * growth;
+    }
     return bound * (1 + 1e-9) + 1e-300;
   };
 }

@@ -76,6 +76,11 @@ struct ModeSystem {
 ModeSystem mode_system(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start,
                        bool drive_external);
 
+/// Whether an eigenbasis V (with its inverse) is well conditioned, ‖V‖∞·‖V⁻¹‖∞ ≤ limit, the row sums
+/// of the moduli |v_ij| as Eigen's cwiseAbs forms them — decided without the moduli where bounds
+/// on them decide it (the mesh modes' flow uses its eigen-decomposition only then).
+bool well_conditioned_basis(const Eigen::MatrixXcd& vectors, const Eigen::MatrixXcd& inverse, double limit);
+
 /// A mode's closed-form motion from a state.
 class ModeFlow {
  public:

@@ -5,6 +5,7 @@
 #include "backlash/numeric/effects_simulation.hpp"
 
 #include "effects/effects_engine.hpp"
+#include "hybrid/certified_search.hpp"
 
 #include <algorithm>
 #include <array>
@@ -102,17 +103,17 @@ struct Start {
 // (A looser on-boundary rule — 1e-11 of the terms — took a real 1e-11 gap for a contact.)
 // On the boundary, the first derivative that is not noise decides: leaving the valid side is
 // an exit at once, entering it starts the search after a certified departure time.
-// With the witness's mode (`mode`: its eᵀA, eᵀA² are the products formed here, the same bits) they
-// are not formed again; the higher derivatives and their rounding scales only on the boundary.
+// The witness's mode holds eᵀA, eᵀA² (the products formed here, the same bits), so they are not
+// formed again; the higher derivatives and their rounding scales only on the boundary.
 // `zdot` = A z0 + c, the start's rate, the same for every witness of the segment.
-Start classify_start(const ModeFlow& flow, const LinearWitness& lw, const WitnessMode* mode, const SmallVector& zdot,
+Start classify_start(const ModeFlow& flow, const WitnessMode& mode, double level, const SmallVector& zdot,
                      double magnitude, double horizon, double t_global) {
   const SmallVector& z0 = flow.local_start();
   const SmallVector& z0_noise = flow.local_start_noise();
-  const SmallMatrix& A = mode ? mode->A : lw.A;
-  const SmallRow& e = mode ? mode->e : lw.e;
+  const SmallMatrix& A = mode.A;
+  const SmallRow& e = mode.e;
   std::array<double, 4> w{};
-  w[0] = dot(e, z0) - lw.level;
+  w[0] = dot(e, z0) - level;
   w[1] = dot(e, zdot);
   constexpr double eps = std::numeric_limits<double>::epsilon();
   const double tolerance = 64 * eps * (abs_dot(e, z0) + magnitude) + 32 * abs_dot(e, z0_noise) +
@@ -120,8 +121,8 @@ Start classify_start(const ModeFlow& flow, const LinearWitness& lw, const Witnes
   if (w[0] > tolerance) return {StartKind::Inside, 0};
   if (w[0] < -tolerance) return {StartKind::ExitNow, 0};
   const SmallVector zdot_scale = A.cwiseAbs() * (z0.cwiseAbs() + z0_noise) + flow.forcing_magnitude();
-  const SmallRow eA = mode ? mode->eA : SmallRow(e * A);
-  const SmallRow eA2 = mode ? mode->eA2 : SmallRow(eA * A);
+  const SmallRow& eA = mode.eA;
+  const SmallRow& eA2 = mode.eA2;
   const std::array<const SmallRow*, 4> rows{nullptr, &e, &eA, &eA2};  // e A^{k−1} for w^{(k)}
   std::array<double, 4> scale{};
   for (int k = 1; k <= 3; ++k) {
@@ -227,20 +228,14 @@ class ExitSearch {
   ExitSearch(const Parameters& p, const ModeFlow& flow, const SampleMemo& memo, const SmallVector& zdot,
              const Witness& witness, double horizon, double t_global)
       : p_(p), flow_(flow), memo_(memo), witness_(witness) {
-    lw_.level = -witness.f.constant;
-    // Without a stiff bound the search on a mode built once (kept per thread: its entry stays put
-    // while this segment's searches run) is the LinearWitness search, bit for bit.
-    std::function<double(double, double)> bound = flow.derivative_bound(witness.f.row, 3);
-    if (!bound) {
-      mode_ = &detail::kept_witness_mode(flow.segment().A, flow.segment().c, witness.f.row);
-    } else {
-      lw_.A = flow.segment().A;
-      lw_.c = flow.segment().c;
-      lw_.e = witness.f.row;
-      lw_.third_derivative_bound = std::move(bound);
-      lw_.state = [&memo](double tau) { return memo.local(tau); };
-    }
-    const Start start = classify_start(flow, lw_, mode_, zdot, witness.f.magnitude, horizon, t_global);
+    level_ = -witness.f.constant;
+    // The search on a mode built once (kept per thread: its entry stays put while this segment's
+    // searches run) is the LinearWitness search, bit for bit — with a stiff bound (the mesh modes)
+    // as without one: the search's constants are WitnessMode(A, c, e) either way, so they are not
+    // built again for each window of each witness (issue 19: the mesh's searches).
+    bound_ = flow.derivative_bound(witness.f.row, 3);
+    mode_ = &detail::kept_witness_mode(flow.segment().A, flow.segment().c, witness.f.row);
+    const Start start = classify_start(flow, *mode_, level_, zdot, witness.f.magnitude, horizon, t_global);
     if (start.kind == StartKind::Never) finished_ = true;
     if (start.kind == StartKind::ExitNow) immediate_ = true;
     from_ = start.from;
@@ -270,20 +265,21 @@ class ExitSearch {
 
  private:
   std::optional<Crossing> search(double until) const {
-    if (!mode_) return first_crossing(lw_, from_, until);
     const auto sample = [this](double tau) {
       WitnessSample s{memo_.local(tau), 0};
       s.value = dot(mode_->e, s.x);
       return s;
     };
-    return first_crossing(*mode_, sample, lw_.level, from_, until);
+    return detail::search(detail::Sampler<decltype(sample)>(*mode_, sample, level_), bound_ ? &bound_ : nullptr, from_,
+                          until, CrossingOptions{});
   }
   const Parameters& p_;
   const ModeFlow& flow_;
   const SampleMemo& memo_;
   Witness witness_;
-  LinearWitness lw_;
-  const WitnessMode* mode_ = nullptr;  // the witness's constants, when the search needs no stiff bound
+  double level_ = 0;
+  std::function<double(double, double)> bound_;  // the stiff flow's bound on |w'''| (mesh modes), or empty
+  const WitnessMode* mode_ = nullptr;  // the witness's constants
   double from_ = 0;
   bool finished_ = false, immediate_ = false;
 };

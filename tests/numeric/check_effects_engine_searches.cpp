@@ -10,7 +10,13 @@
 //                                 again is not the next one overwritten (main's round robin replaced
 //                                 it), and it stays bit for bit WitnessMode(A, c, e);
 //   free_kernels_as_coupled       a free flight's kernels of one node (phi_pair) are coupled_kernels'
-//                                 own, bit for bit.
+//                                 own, bit for bit;
+//   check_conditioning_decided_as_by_the_moduli
+//                                 the mesh flow's test of its eigenbasis (bounds on the moduli first)
+//                                 answers as the test on the moduli themselves, on random bases with
+//                                 the limit placed at, just around and far from their condition;
+//   check_mesh_bound_holds        the mesh modes' bound on |w'''| over [a, b] (a conjugate pair's
+//                                 exponential formed once) is not below |eᵀA²(A z + c)| anywhere on it.
 #include "effects/effect_modes.hpp"
 #include "effects/effects_engine.hpp"
 #include "evaluators/phi_functions.hpp"
@@ -44,17 +50,16 @@ numeric::Effects compliance() {
 
 bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
-}  // namespace
-
-TEST(EffectsEngineSearches, compliance_flow_is_the_augmented_exponential) {
+// Case V with compliance(): `check(mode, flow)` on each mesh mode's flow from `trials` random starts
+// (the teeth overlapping on its face by up to 1e-3 rad).
+template <class Check>
+void for_mesh_flows(std::mt19937& random, int trials, const Check& check) {
   const numeric::Parameters p = numeric::parameters_of(model::load_case("V"));
   const numeric::Effects e = compliance();
-  std::mt19937 random(19);
   std::uniform_real_distribution<double> unit(-1, 1);
-  int checked = 0;
   for (const numeric::Mode& m : numeric::reachable_modes(p, e)) {
     if (m.kind != numeric::ModeKind::Mesh) continue;
-    for (int trial = 0; trial < 20; ++trial) {
+    for (int trial = 0; trial < trials; ++trial) {
       numeric::HybridState start;
       start.in_contact = true;
       start.face = m.face;
@@ -62,24 +67,33 @@ TEST(EffectsEngineSearches, compliance_flow_is_the_augmented_exponential) {
       start.theta_L = start.theta_m + m.face * (p.backlash / 2 + 1e-3 * std::fabs(unit(random)));
       start.dtheta_m = unit(random);
       start.dtheta_L = unit(random);
-      const numeric::ModeFlow flow(p, e, m, start);
-      ASSERT_FALSE(flow.uses_matrix_exponential()) << m.describe();
-      const int n = static_cast<int>(flow.segment().A.rows());
-      Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n + 1, n + 1);
-      M.topLeftCorner(n, n) = flow.segment().A;
-      M.block(0, n, n, 1) = flow.segment().c;
-      Eigen::VectorXd z0(n + 1);
-      z0.head(n) = flow.local_start();
-      z0(n) = 1;
-      for (double tau : {1e-3, 0.05, 0.4, 2.0}) {
-        const Eigen::VectorXd reference = ((M * tau).exp() * z0).head(n);
-        const numeric::SmallVector z = flow.local(tau);
-        const double scale = std::max(1.0, reference.cwiseAbs().maxCoeff());
-        EXPECT_LE((z - reference).cwiseAbs().maxCoeff(), 1e-12 * scale) << m.describe() << ", tau " << tau;
-        ++checked;
-      }
+      check(m, numeric::ModeFlow(p, e, m, start));
     }
   }
+}
+
+}  // namespace
+
+TEST(EffectsEngineSearches, compliance_flow_is_the_augmented_exponential) {
+  std::mt19937 random(19);
+  int checked = 0;
+  for_mesh_flows(random, 20, [&checked](const numeric::Mode& m, const numeric::ModeFlow& flow) {
+    ASSERT_FALSE(flow.uses_matrix_exponential()) << m.describe();
+    const int n = static_cast<int>(flow.segment().A.rows());
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n + 1, n + 1);
+    M.topLeftCorner(n, n) = flow.segment().A;
+    M.block(0, n, n, 1) = flow.segment().c;
+    Eigen::VectorXd z0(n + 1);
+    z0.head(n) = flow.local_start();
+    z0(n) = 1;
+    for (double tau : {1e-3, 0.05, 0.4, 2.0}) {
+      const Eigen::VectorXd reference = ((M * tau).exp() * z0).head(n);
+      const numeric::SmallVector z = flow.local(tau);
+      const double scale = std::max(1.0, reference.cwiseAbs().maxCoeff());
+      EXPECT_LE((z - reference).cwiseAbs().maxCoeff(), 1e-12 * scale) << m.describe() << ", tau " << tau;
+      ++checked;
+    }
+  });
   EXPECT_GT(checked, 0);
 }
 
@@ -123,4 +137,59 @@ TEST(EffectsEngineSearches, free_kernels_as_coupled) {
     EXPECT_TRUE(same_bits(k.exp_x, px.e) && same_bits(k.phi1_x, px.phi1) && same_bits(k.phi2_x, px.phi2)) << x;
     EXPECT_TRUE(same_bits(k.exp_y, py.e) && same_bits(k.phi1_y, py.phi1) && same_bits(k.phi2_y, py.phi2)) << y;
   }
+}
+
+TEST(EffectsEngineSearches, check_conditioning_decided_as_by_the_moduli) {
+  std::mt19937 random(1919);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  std::uniform_int_distribution<int> size_of(2, 5), exponent(-8, 8);
+  int decided = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const int n = size_of(random);
+    Eigen::MatrixXcd V(n, n);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) V(i, j) = {unit(random) * std::ldexp(1.0, exponent(random) / 2), unit(random)};
+    if (trial % 97 == 0) V(0, 0) = {NAN, 0};
+    if (trial % 89 == 0) V(n - 1, 0) = {INFINITY, 1};
+    const Eigen::MatrixXcd inverse = Eigen::PartialPivLU<Eigen::MatrixXcd>(V).inverse();
+    const double condition = V.cwiseAbs().rowwise().sum().maxCoeff() * inverse.cwiseAbs().rowwise().sum().maxCoeff();
+    for (double factor : {1.0, 1 + 1e-15, 1 - 1e-15, 1 + 1e-7, 1 - 1e-7, 1.5, 0.7, 1e3, 1e-3}) {
+      const double limit = std::isfinite(condition) ? condition * factor : 1e7 * factor;
+      const bool exact = std::isfinite(condition) && condition <= limit;
+      EXPECT_EQ(numeric::well_conditioned_basis(V, inverse, limit), exact)
+          << "trial " << trial << ", condition " << condition << ", limit " << limit;
+      ++decided;
+    }
+  }
+  EXPECT_EQ(decided, 2000 * 9);
+}
+
+TEST(EffectsEngineSearches, check_mesh_bound_holds) {
+  std::mt19937 random(23), rows(29);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  int checked = 0;
+  for_mesh_flows(random, 10, [&](const numeric::Mode& m, const numeric::ModeFlow& flow) {
+    const numeric::SmallMatrix& A = flow.segment().A;
+    numeric::SmallRow row(A.rows());
+    for (Eigen::Index i = 0; i < row.size(); ++i) row(i) = unit(rows);
+    const auto bound = flow.derivative_bound(row, 3);
+    ASSERT_TRUE(static_cast<bool>(bound)) << m.describe();
+    const numeric::SmallRow third = row * A * A;  // w''' = e A² z'
+    for (double a : {0.0, 0.01, 0.3}) {
+      const double b = a + 0.05 * (1 + std::fabs(unit(rows)));
+      const double M3 = bound(a, b);
+      double largest = 0;
+      for (int k = 0; k <= 64; ++k) {
+        const numeric::SmallVector z = flow.local(a + (b - a) * k / 64);
+        const numeric::SmallVector rate = A * z + flow.segment().c;
+        double w3 = 0;
+        for (Eigen::Index i = 0; i < rate.size(); ++i) w3 += third(i) * rate(i);
+        largest = std::max(largest, std::fabs(w3));
+      }
+      EXPECT_GE(M3, largest * (1 - 1e-9)) << m.describe() << " on [" << a << ", " << b << "]";
+      EXPECT_LE(M3, 1e6 * largest + 1e-6) << m.describe() << ": far above |w'''|, every interval would be halved";
+      ++checked;
+    }
+  });
+  EXPECT_GT(checked, 0);
 }
