@@ -204,7 +204,7 @@ void compare_free_mode(const SegmentEvaluator& evaluator, const ValidationOption
     std::vector<double> times = free_times;
     bool recombined = false;
     std::vector<FreeState> reference = reference_until_recombination(centred, v0, times, o.odeint_tolerance, recombined);
-    if (recombined) {
+    if (recombined && reference.size() < times.size()) {
       // Recombination cuts the segment short: resample [0, t_recombination] as finely.
       times = time_grid(times[reference.size() - 1], o.time_points);
       reference = reference_until_recombination(centred, v0, times, o.odeint_tolerance, recombined);
