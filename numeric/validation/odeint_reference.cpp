@@ -4,7 +4,9 @@
 #include <boost/numeric/odeint.hpp>
 
 #include <array>
+#include <functional>
 #include <stdexcept>
+#include <type_traits>
 
 namespace backlash::numeric {
 
@@ -70,15 +72,20 @@ std::vector<double> scaled_grid(const std::vector<double>& times, double unit, b
   return grid;
 }
 
+// Thrown by the observer once the caller's `until` holds: the integration ends at that sample.
+struct Reached {};
+
 void check_complete(std::size_t computed, const std::vector<double>& times) {
   if (computed != times.size())
     throw std::runtime_error("reference trajectory: odeint stopped after " + std::to_string(computed) + " of " +
                              std::to_string(times.size()) + " times");
 }
 
-template <class Vector, class System, class Convert>
+// The states at `times`; with `until`, only up to the first state for which it holds (the
+// samples before it are the same bits: the stepper's path does not depend on where it stops).
+template <class Vector, class System, class Convert, class Until = std::nullptr_t>
 auto integrate(const System& system, Vector x0, const std::vector<double>& times, double tolerance,
-               const Convert& convert) {
+               const Convert& convert, const Until& until = nullptr) {
   using Out = decltype(convert(x0));
   check_times(times);
   std::vector<Out> out;
@@ -93,14 +100,20 @@ auto integrate(const System& system, Vector x0, const std::vector<double>& times
     for (double& d : dx) d *= unit;
   };
   auto stepper = odeint::make_dense_output(tolerance, tolerance, odeint::runge_kutta_dopri5<Vector>());
-  odeint::integrate_times(stepper, scaled, x0, grid.begin(), grid.end(), initial_step(grid),
-                          [&](const Vector& x, double) {
-                            if (skip) {
-                              skip = false;
-                              return;
-                            }
-                            out.push_back(convert(x));
-                          });
+  try {
+    odeint::integrate_times(stepper, scaled, x0, grid.begin(), grid.end(), initial_step(grid),
+                            [&](const Vector& x, double) {
+                              if (skip) {
+                                skip = false;
+                                return;
+                              }
+                              out.push_back(convert(x));
+                              if constexpr (!std::is_null_pointer_v<Until>)
+                                if (until && until(out.back())) throw Reached{};
+                            });
+  } catch (const Reached&) {
+    return out;
+  }
   check_complete(out.size(), times);
   return out;
 }
@@ -112,8 +125,13 @@ ContactState contact_from(const ContactVector& x) { return ContactState{x[0], x[
 
 std::vector<FreeState> reference_free_trajectory(const Parameters& p, double v0, const std::vector<double>& times,
                                                  double tolerance) {
+  return reference_free_trajectory(p, v0, times, tolerance, {});
+}
+
+std::vector<FreeState> reference_free_trajectory(const Parameters& p, double v0, const std::vector<double>& times,
+                                                 double tolerance, const std::function<bool(const FreeState&)>& until) {
   const double theta0 = p.theta_R + cot_phi(p) * v0;
-  return integrate<FreeVector>(FreeSystem{p}, FreeVector{theta0, v0, theta0, v0}, times, tolerance, &free_from);
+  return integrate<FreeVector>(FreeSystem{p}, FreeVector{theta0, v0, theta0, v0}, times, tolerance, &free_from, until);
 }
 
 std::vector<ContactState> reference_contact_trajectory(const Parameters& p, double theta_o0, double dtheta_o0,

@@ -49,20 +49,41 @@ std::vector<double> time_grid(double horizon, int points) {
   return grid;
 }
 
-// Number of samples up to and including recombination (gap changed by b, or
-// back through 0).
-std::size_t until_recombination(const std::vector<FreeState>& reference, double backlash) {
-  int sign = 0;
-  for (std::size_t i = 1; i < reference.size(); ++i) {
-    const double gap = reference[i].gap;
-    if (backlash > 0 && std::fabs(gap) >= backlash) return i + 1;
-    if (sign == 0) {
-      if (std::fabs(gap) > 1e-12) sign = gap > 0 ? 1 : -1;
-    } else if (gap * sign <= 0) {
-      return i + 1;
+// Recombination along a free trajectory, sample by sample from the first (t = 0): the gap has
+// changed by b, or come back through 0.
+class Recombination {
+ public:
+  explicit Recombination(double backlash) : backlash_(backlash) {}
+  /// The next sample's gap; true at the first sample of recombination (and after it).
+  bool reached(double gap) {
+    if (seen_++ == 0 || found_) return found_;
+    if (backlash_ > 0 && std::fabs(gap) >= backlash_) return found_ = true;
+    if (sign_ == 0) {
+      if (std::fabs(gap) > 1e-12) sign_ = gap > 0 ? 1 : -1;
+    } else if (gap * sign_ <= 0) {
+      found_ = true;
     }
+    return found_;
   }
-  return reference.size();
+  bool found() const { return found_; }
+
+ private:
+  double backlash_;
+  long seen_ = 0;
+  int sign_ = 0;
+  bool found_ = false;
+};
+
+// The reference at `times` up to and including the first sample of recombination (all of them
+// when there is none), and whether it recombined: odeint stops there (the samples before are
+// the same bits as a run to the end).
+std::vector<FreeState> reference_until_recombination(const Parameters& centred, double v0, const std::vector<double>& times,
+                                                     double tolerance, bool& recombined) {
+  Recombination r(centred.backlash);
+  std::vector<FreeState> reference =
+      reference_free_trajectory(centred, v0, times, tolerance, [&r](const FreeState& s) { return r.reached(s.gap); });
+  recombined = r.found();
+  return reference;
 }
 
 // The largest absolute error and, separately, the largest error relative to the trajectory's
@@ -181,14 +202,14 @@ void compare_free_mode(const SegmentEvaluator& evaluator, const ValidationOption
   const std::vector<double> free_times = time_grid(r.free_horizon, o.time_points);
   for (double v0 : o.dtheta_m0_grid) {
     std::vector<double> times = free_times;
-    std::vector<FreeState> reference = reference_free_trajectory(centred, v0, times, o.odeint_tolerance);
-    std::size_t n = until_recombination(reference, p.backlash);
-    if (n < reference.size()) {
+    bool recombined = false;
+    std::vector<FreeState> reference = reference_until_recombination(centred, v0, times, o.odeint_tolerance, recombined);
+    if (recombined && reference.size() < times.size()) {
       // Recombination cuts the segment short: resample [0, t_recombination] as finely.
-      times = time_grid(times[n - 1], o.time_points);
-      reference = reference_free_trajectory(centred, v0, times, o.odeint_tolerance);
-      n = until_recombination(reference, p.backlash);
+      times = time_grid(times[reference.size() - 1], o.time_points);
+      reference = reference_until_recombination(centred, v0, times, o.odeint_tolerance, recombined);
     }
+    const std::size_t n = reference.size();
     ++r.free_trajectories;
     double position_scale = 0, motor_speed = 0, load_speed = 0;
     for (std::size_t i = 0; i < n; ++i) {

@@ -56,3 +56,43 @@ TEST(LimitCycleCost, item2_cold_search_within_1_5_warm) {
   // (a tracked half cycle, 25 evaluations more here) break it.
   EXPECT_LT(static_cast<double>(cold_cost - warm_cost), 1.5 * static_cast<double>(half_cost));
 }
+
+// Maps (sweep.cpp's continuation): along a grid line the line through the last two cycles is a
+// better first guess than the last cycle alone (its error is second order in the grid step), so
+// Newton settles with fewer evaluations, on the same cycle (to its convergence test, 1e-13 v).
+// Case V's parametric evaluator along FL/F (F fixed), a step of 1/99 as in the 100 × 100 map.
+TEST(LimitCycleCost, continuation_from_the_line_through_two_neighbours) {
+  const numeric::Parameters base = numeric::parameters_of(model::load_case("V"));
+  const double F = base.Fm + base.FL, step = 1.0 / 99;
+  double cycles[2] = {0, 0};
+  long line_total = 0, neighbour_total = 0;
+  for (int k = 0; k < 12; ++k) {
+    numeric::Parameters p = base;
+    p.theta_R = 0;
+    p.FL = (0.2 + k * step) * F;
+    p.Fm = F - p.FL;
+    const auto counter = std::make_shared<const CountingEvaluator>(numeric::parametric_evaluator(p));
+    const numeric::ValidationResult validated = numeric::validate(counter);
+    ASSERT_TRUE(validated.passed());
+    numeric::LimitCycleOptions neighbour, line;
+    neighbour.guess = cycles[1];
+    line.guess = k >= 2 ? 2 * cycles[1] - cycles[0] : cycles[1];  // the line through the last two, one step on
+    long before = counter->evaluations;
+    const numeric::LimitCycle from_neighbour = numeric::find_limit_cycle(validated.evaluator(), neighbour);
+    const long neighbour_cost = counter->evaluations - before;
+    before = counter->evaluations;
+    const numeric::LimitCycle from_line = numeric::find_limit_cycle(validated.evaluator(), line);
+    const long line_cost = counter->evaluations - before;
+    ASSERT_EQ(from_neighbour.status, numeric::CycleStatus::LimitCycle);
+    ASSERT_EQ(from_line.status, numeric::CycleStatus::LimitCycle);
+    EXPECT_FALSE(from_line.survey_fallback);
+    EXPECT_NEAR(from_line.separation_velocity, from_neighbour.separation_velocity,
+                1e-12 * from_neighbour.separation_velocity);
+    if (k >= 2) line_total += line_cost, neighbour_total += neighbour_cost;
+    cycles[0] = cycles[1];
+    cycles[1] = from_neighbour.separation_velocity;
+  }
+  std::printf("case V along FL/F, 10 points: from the neighbour %ld evaluations, from the line through two %ld\n",
+              neighbour_total, line_total);
+  EXPECT_LT(static_cast<double>(line_total), 0.9 * static_cast<double>(neighbour_total));
+}

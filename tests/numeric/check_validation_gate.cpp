@@ -2,14 +2,19 @@
 // (max abs error ≤ 1e-9 per state over each segment's whole horizon), for the
 // eight thesis cases (generated, parametric, direct) and every pole-structure
 // branch (parametric, direct); the gate refuses an evaluator that is wrong,
-// with a clear status, and hands out no ValidatedEvaluator for it.
+// with a clear status, and hands out no ValidatedEvaluator for it.  The reference stopped at
+// recombination (the gate's free mode) is the same bits as the whole run up to there.
 #include "backlash/model/case_spec.hpp"
 #include "backlash/numeric/evaluator.hpp"
+#include "backlash/numeric/parameters.hpp"
+#include "backlash/numeric/reference.hpp"
 #include "backlash/numeric/validation.hpp"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -138,6 +143,32 @@ TEST(Evaluators, case_files_with_other_numbers_get_the_parametric_evaluator) {
   EXPECT_EQ(case_evaluator(spec)->kind(), "parametric");
   EXPECT_EQ(generated_case_evaluator("nope"), nullptr);
   EXPECT_EQ(generated_case_ids(), backlash::model::thesis_case_ids());
+}
+
+// The gate stops the free mode's reference at the first sample of recombination
+// (validation.cpp): what it compares must be the bits of the run to the end, up to that sample.
+TEST(ReferenceTrajectory, stopped_run_is_the_prefix_of_the_whole_run) {
+  Parameters p = parameters_of(backlash::model::load_case("V"));
+  p.theta_R = 0;
+  std::vector<double> times;
+  for (int i = 0; i <= 400; ++i) times.push_back(0.1 * i);
+  for (const double v0 : {-2.0, -0.3, 1.0, 2.0}) {
+    const std::vector<FreeState> whole = reference_free_trajectory(p, v0, times);
+    ASSERT_EQ(whole.size(), times.size());
+    std::size_t first = 0;  // the first sample whose gap has changed by b/2
+    while (first < whole.size() && std::fabs(whole[first].gap) < p.backlash / 2) ++first;
+    ASSERT_LT(first, whole.size()) << "v0 = " << v0 << ": the gap never changes by b/2";
+    const std::vector<FreeState> stopped = reference_free_trajectory(
+        p, v0, times, 1e-12, [&p](const FreeState& s) { return std::fabs(s.gap) >= p.backlash / 2; });
+    ASSERT_EQ(stopped.size(), first + 1) << "v0 = " << v0;
+    for (std::size_t i = 0; i < stopped.size(); ++i) {
+      EXPECT_EQ(stopped[i].theta_m, whole[i].theta_m) << "v0 = " << v0 << ", sample " << i;
+      EXPECT_EQ(stopped[i].dtheta_m, whole[i].dtheta_m) << "v0 = " << v0 << ", sample " << i;
+      EXPECT_EQ(stopped[i].theta_L, whole[i].theta_L) << "v0 = " << v0 << ", sample " << i;
+      EXPECT_EQ(stopped[i].dtheta_L, whole[i].dtheta_L) << "v0 = " << v0 << ", sample " << i;
+      EXPECT_EQ(stopped[i].gap, whole[i].gap) << "v0 = " << v0 << ", sample " << i;
+    }
+  }
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "backlash/numeric/parametric.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
 
+#include <functional>
 #include <vector>
 
 namespace backlash::numeric {
@@ -21,6 +22,10 @@ namespace backlash::numeric {
 /// States at `times` (non-decreasing, ≥ 0; t = 0 is the separation point).
 std::vector<FreeState> reference_free_trajectory(const Parameters& p, double dtheta_m0, const std::vector<double>& times,
                                                  double tolerance = 1e-12);
+/// The same, ending at the first state for which `until` holds (that state included): the states
+/// before it are the same bits as the whole run's (the gate stops at recombination, validation.cpp).
+std::vector<FreeState> reference_free_trajectory(const Parameters& p, double dtheta_m0, const std::vector<double>& times,
+                                                 double tolerance, const std::function<bool(const FreeState&)>& until);
 std::vector<ContactState> reference_contact_trajectory(const Parameters& p, double theta_o0, double dtheta_o0,
                                                        const std::vector<double>& times, double tolerance = 1e-12);
 
