@@ -329,14 +329,13 @@ LimitCycle find_limit_cycle(const ValidatedEvaluator& evaluator, const LimitCycl
     cycle.reason = "no backlash: a rigid drive never separates, so there is no cycle";
     return cycle;
   }
-  // Newton's method from the neighbours' cycles (options.guess, second_guess), else from the describing
+  // Newton's method from the neighbour's cycle (options.guess), else from the describing
   // function's; the logarithmic grid survey only when neither settles on a stable cycle.
   std::optional<NewtonResult> newton;
   auto from = [&](double guess) {
     if (!newton && !options.survey_only && guess > 0 && std::isfinite(guess)) newton = newton_fixed_point(evaluator, guess);
   };
   from(options.guess);
-  if (options.second_guess != options.guess) from(options.second_guess);
   if (!newton) from(describing_function_separation_velocity(p));
   HalfCycle half;
   if (newton) {

@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cmath>
 #include <condition_variable>
 #include <exception>
 #include <map>
@@ -98,32 +97,21 @@ SweepStatus sweep_status(CycleStatus status) {
 
 namespace {
 
-// The warm start a block carries from point to point (continuation): the last two cycles along
-// the grid line, and the separation at which the settle run stopped on the last one
-// (SettleOptions::expected_separation).
+// The warm start a block carries from point to point (continuation): the cycle, and the
+// separation at which the settle run stopped on it (SettleOptions::expected_separation).
 struct Continuation {
-  double guess = 0, x = 0;                 // the last point's separation velocity (0: none) and its x
-  double guess_before = 0, x_before = 0;   // the one before it
+  double guess = 0;
   long settle_separation = 0;
   std::optional<HybridState> warm;
   std::string series;
   bool first = true;
-  void forget() { guess = guess_before = 0, warm.reset(); }
-  void remember(double at, double v) { guess_before = guess, x_before = x, guess = v, x = at; }
-  /// Newton's first guess at `at`: the line through the last two cycles (its error is second
-  /// order in the grid step, so Newton needs a step less), else the last cycle.
-  double predicted(double at) const {
-    if (!(guess > 0 && guess_before > 0 && x != x_before)) return guess;
-    const double line = guess + (guess - guess_before) * (at - x) / (x - x_before);
-    return line > 0 && std::isfinite(line) ? line : guess;
-  }
 };
 
 SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& family, Continuation& c,
                    const SettleOptions& settle) {
   SweepRow row;
   row.point = point;
-  if (c.first || point.series != c.series) c.forget(), c.settle_separation = 0;
+  if (c.first || point.series != c.series) c.guess = 0, c.warm.reset(), c.settle_separation = 0;
   c.first = false;
   c.series = point.series;
   Parameters q = point.parameters;  // error coordinates: θR = 0
@@ -135,14 +123,14 @@ SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& fam
     if (problem) {
       row.status = SweepStatus::Refused;
       row.reason = *problem;
-      c.forget();
+      c.guess = 0, c.warm.reset();
       return row;
     }
     const ValidatedParametricFamily::Verdict verdict = family.judge(q);
     if (!verdict.evaluator) {
       row.status = SweepStatus::Unvalidated;
       row.reason = verdict.reason;
-      c.forget();
+      c.guess = 0, c.warm.reset();
       return row;
     }
     const BranchSelection b = select_branches(q);
@@ -165,10 +153,9 @@ SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& fam
       if (settle.step != 0) row.settle = settle_time(gate.model(), row.cycle, settle);
     } else {
       LimitCycleOptions lc;
-      lc.guess = c.predicted(point.x);
-      lc.second_guess = c.guess;
+      lc.guess = c.guess;
       row.cycle = find_limit_cycle(*verdict.evaluator, lc);
-      c.remember(point.x, row.cycle.status == CycleStatus::LimitCycle ? row.cycle.separation_velocity : 0);
+      c.guess = row.cycle.status == CycleStatus::LimitCycle ? row.cycle.separation_velocity : 0;
       if (settle.step != 0) {
         SettleOptions o = settle;
         o.expected_separation = c.settle_separation;
@@ -183,7 +170,7 @@ SweepRow sweep_row(const SweepPoint& point, const ValidatedParametricFamily& fam
   } catch (const std::exception& e) {
     row.status = SweepStatus::Error;
     row.reason = e.what();
-    c.forget();
+    c.guess = 0, c.warm.reset();
   }
   return row;
 }

@@ -92,8 +92,6 @@ struct LimitCycleOptions {
   int grid = 40;                    ///< logarithmic grid points for the bracketing search
   double guess = 0;                 ///< > 0: Newton's first guess (continuation in sweeps and maps), tried
                                     ///< before the describing function's; the grid survey if neither settles
-  double second_guess = 0;          ///< > 0: tried next when Newton from `guess` does not settle (maps: the
-                                    ///< neighbour's cycle, after the line through the last two)
   bool survey_only = false;         ///< the grid survey alone, no Newton (checks of the fast path)
   bool list_other_fixed_points = false;  ///< also run the grid survey after Newton has settled, so that
                                          ///< other_fixed_points lists every further cycle (the facade's
