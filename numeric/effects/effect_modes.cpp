@@ -119,7 +119,6 @@ bool well_conditioned_basis(const Eigen::MatrixXcd& vectors, const Eigen::Matrix
   return std::isfinite(condition) && condition <= limit;
 }
 
-
 // z̃(τ) = e^{Mτ} z̃0 for the augmented M = [[A, c], [0, 0]]: by the eigen-decomposition of M when
 // it is diagonalisable with a well-conditioned basis (the generic mesh mode: two complex pairs
 // and the augmentation's 0), else by Eigen's Padé exponential at each τ.

@@ -65,7 +65,6 @@ class Recombination {
     }
     return found_;
   }
-  bool found() const { return found_; }
 
  private:
   double backlash_;
@@ -75,15 +74,12 @@ class Recombination {
 };
 
 // The reference at `times` up to and including the first sample of recombination (all of them
-// when there is none), and whether it recombined: odeint stops there (the samples before are
-// the same bits as a run to the end).
+// when there is none): odeint stops there (the samples before are the same bits as a run to the
+// end), so fewer states than times means it recombined before the last.
 std::vector<FreeState> reference_until_recombination(const Parameters& centred, double v0, const std::vector<double>& times,
-                                                     double tolerance, bool& recombined) {
+                                                     double tolerance) {
   Recombination r(centred.backlash);
-  std::vector<FreeState> reference =
-      reference_free_trajectory(centred, v0, times, tolerance, [&r](const FreeState& s) { return r.reached(s.gap); });
-  recombined = r.found();
-  return reference;
+  return reference_free_trajectory(centred, v0, times, tolerance, [&r](const FreeState& s) { return r.reached(s.gap); });
 }
 
 // The largest absolute error and, separately, the largest error relative to the trajectory's
@@ -202,12 +198,11 @@ void compare_free_mode(const SegmentEvaluator& evaluator, const ValidationOption
   const std::vector<double> free_times = time_grid(r.free_horizon, o.time_points);
   for (double v0 : o.dtheta_m0_grid) {
     std::vector<double> times = free_times;
-    bool recombined = false;
-    std::vector<FreeState> reference = reference_until_recombination(centred, v0, times, o.odeint_tolerance, recombined);
-    if (recombined && reference.size() < times.size()) {
+    std::vector<FreeState> reference = reference_until_recombination(centred, v0, times, o.odeint_tolerance);
+    if (reference.size() < times.size()) {
       // Recombination cuts the segment short: resample [0, t_recombination] as finely.
       times = time_grid(times[reference.size() - 1], o.time_points);
-      reference = reference_until_recombination(centred, v0, times, o.odeint_tolerance, recombined);
+      reference = reference_until_recombination(centred, v0, times, o.odeint_tolerance);
     }
     const std::size_t n = reference.size();
     ++r.free_trajectories;
