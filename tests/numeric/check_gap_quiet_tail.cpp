@@ -48,21 +48,12 @@ Parameters random_drive(std::mt19937_64& random) {
   return p;
 }
 
-// A flight leaving the face σ with both bodies at one velocity about θR, its relative
-// acceleration away from the face; `near`: within b/2 of θR at b/2 per time unit at most (the
-// swings that mostly end inside the backlash), else within 0.3 rad at 0.3 rad/s (mostly a face).
+// A flight leaving the face σ (flight_leaving_face); `near`: within b/2 of θR at b/2 per time
+// unit at most (the swings that mostly end inside the backlash), else within 0.3 rad at 0.3 rad/s
+// (mostly a face).
 std::optional<SmallVector> flight_from_face(const Parameters& p, std::mt19937_64& random, int& face, bool near) {
   const double spread = near ? p.backlash / 2 : 0.3, max_speed = near ? p.backlash / 2 * std::sqrt(p.K / p.Jm) : 0.3;
-  std::uniform_real_distribution<double> angle(p.theta_R - spread, p.theta_R + spread), speed(-max_speed, max_speed);
-  face = random() % 2 ? 1 : -1;
-  SmallVector x(4);
-  const double v = speed(random);
-  x << angle(random), v, 0, v;
-  x(2) = x(0) + face * p.backlash / 2;
-  const LinearSegment free = free_mode_segment(p);
-  const SmallVector rate = free.A * x + free.c;
-  if (!((rate(3) - rate(1)) * face < 0)) return std::nullopt;
-  return x;
+  return backlash::testing::flight_leaving_face(p, random, face, spread, max_speed);
 }
 
 // The first scan point on [from, horizon] (n + 1 points, both ends) where the exact gap change is
