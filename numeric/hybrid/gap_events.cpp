@@ -62,18 +62,21 @@ std::optional<LevelEvent> sequential_search(const Level& first, const Level& sec
 constexpr int kFirstStretchWindows = 3;
 
 // One level advanced over its whole search's windows: none crosses on (start, end] unless found;
-// (begin, end] is the window searched last, or the one holding the crossing found.
+// (begin, end] is the window searched last, or the one holding the crossing found.  `limit`
+// (≤ horizon): neither level crosses on [limit, horizon] (a quiet tail, quiet_gap_from), so the
+// windows stop there, the last one cut at it.
 struct Track {
   const Level& level;
-  double horizon, first_window, window, begin, end;
+  double horizon, limit, first_window, window, begin, end;
   bool started = false, exact = false;  ///< exact: found by the level's whole search (its reference time)
   std::optional<Crossing> found;
 
-  Track(const Level& l, double horizon_, double first_window_)
-      : level(l), horizon(horizon_), first_window(first_window_), window(first_window_), begin(l.start()), end(begin) {}
-  bool exhausted() const { return found || end >= horizon; }
-  // No crossing of this level on (start, x] (x ≤ horizon, or the horizon reached).
-  bool clear_beyond(double x) const { return found ? found->t > x : (end >= x || end >= horizon); }
+  Track(const Level& l, double horizon_, double limit_, double first_window_)
+      : level(l), horizon(horizon_), limit(limit_), first_window(first_window_), window(first_window_),
+        begin(l.start()), end(begin) {}
+  bool exhausted() const { return found || end >= limit; }
+  // No crossing of this level on (start, x] (x ≤ horizon, or the limit reached: the tail is quiet).
+  bool clear_beyond(double x) const { return found ? found->t > x : (end >= x || end >= limit); }
   // The whole search's windows from the start, its ends computed as first_crossing's search does,
   // up to the first one that ends at or after `t`, `count` of them at least: (begin, end].
   void windows_to(double t, int count) {
@@ -86,18 +89,21 @@ struct Track {
     }
   }
   // The first call: the level's whole search over its first windows, to `reach` at least (its
-  // crossing there is the reference's).  Later calls: the next window, a certified search of its own.
+  // crossing there is the reference's), or a search of its own when they pass the limit (cut
+  // there).  Later calls: the next window, a certified search of its own.
   void advance(double reach, int windows = 1) {
     if (!started) {
-      started = exact = true;
+      started = true;
       windows_to(reach, windows);
+      exact = end <= limit;
+      end = std::max(begin, std::min(end, limit));
       found = level.search(level.start(), end);
-      if (found) windows_to(found->t, 1);  // the window that holds it
+      if (found && exact) windows_to(found->t, 1);  // the window that holds it
       return;
     }
     exact = false;
     begin = end;
-    end = horizon - begin <= window ? horizon : begin + window;
+    end = limit - begin <= window ? limit : begin + window;
     window *= 2;
     found = level.search(begin, end);
   }
@@ -149,13 +155,20 @@ Windowed windowed_search(Track& a, Track& b, const long& samples, bool first_set
 // The first level's first stretch as the reference searches it — a crossing there (or none on the
 // whole horizon) is the reference's, and the second level is then searched as the reference does
 // —, else both levels window by window, and the sequential searches where they cannot settle.
+// With a quiet tail from `limit` on, no window goes past it: a crossing found in a stretch cut at
+// the limit is taken from the level's whole search (the reference's time), and a first level
+// clear up to the limit leaves the second to its windows up to the limit, not to its whole search.
 std::optional<LevelEvent> windowed_levels(const Level& first, const Level& second, double horizon, double first_window,
-                                          const long& samples, bool first_settles) {
-  Track a(first, horizon, first_window);
+                                          const long& samples, bool first_settles, double limit) {
+  Track a(first, horizon, limit, first_window);
   a.advance(-INFINITY, kFirstStretchWindows);
+  if (a.found && !a.exact) {
+    a.found = a.whole();
+    if (!a.found) return sequential_search(first, second, horizon);
+  }
   if (first_settles && a.found && !a.found->grazing) return LevelEvent{false, *a.found};
-  if (a.exhausted()) return with_second(a.found, second, horizon);
-  Track b(second, horizon, first_window);
+  if (a.found || a.end >= horizon) return with_second(a.found, second, horizon);
+  Track b(second, horizon, limit, first_window);
   const Windowed windowed = windowed_search(a, b, samples, first_settles);
   if (windowed.settled) return windowed.event;
   return sequential_search(first, second, horizon);
@@ -165,9 +178,11 @@ std::optional<LevelEvent> windowed_levels(const Level& first, const Level& secon
 
 // The two levels, window by window when the mode has a time scale, else one after the other.
 std::optional<LevelEvent> first_of_two_levels(const Level& first, const Level& second, double horizon,
-                                              double first_window, const long& samples, bool first_settles) {
+                                              double first_window, const long& samples, bool first_settles,
+                                              double quiet_from) {
   if (!(first_window > 0) || !std::isfinite(first_window)) return sequential_search(first, second, horizon);
-  return windowed_levels(first, second, horizon, first_window, samples, first_settles);
+  const double limit = quiet_from < horizon ? std::max(0.0, quiet_from) : horizon;
+  return windowed_levels(first, second, horizon, first_window, samples, first_settles, limit);
 }
 
 // The gap rate of a free flight (free_mode_segment): θ̇L' = −(FL/JL) θ̇L, so (D + a) θ̇L = 0 with

@@ -5,6 +5,7 @@
 #include "backlash/numeric/first_crossing.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
 #include "hybrid/certified_search.hpp"
+#include "hybrid/quiet_tail.hpp"
 
 #include <algorithm>
 #include <functional>
@@ -78,9 +79,12 @@ struct LevelEvent {
 /// when the mode has a time scale (`first_window`); `samples` counts the samples taken so far.
 /// `first_settles`: the second level is known not to cross before a crossing of the first that is
 /// not grazing (a flight whose gap turns at most once, gap_rate_turns_at_most_once), so such a
-/// crossing is the event without the second level's search up to it.
+/// crossing is the event without the second level's search up to it.  `quiet_from`: neither
+/// level is crossed on [quiet_from, horizon] (quiet_gap_from), so no window goes past it; the
+/// event found, or none, is the same.
 std::optional<LevelEvent> first_of_two_levels(const Level& first, const Level& second, double horizon,
-                                              double first_window, const long& samples, bool first_settles = false);
+                                              double first_window, const long& samples, bool first_settles = false,
+                                              double quiet_from = INFINITY);
 
 /// Whether the gap rate Δx' = θ̇L − θ̇m of every free flight of `p` has at most two real zeros
 /// (counted with multiplicity): it then solves a third-order linear ODE with real characteristic
@@ -148,8 +152,14 @@ std::optional<GapEvent> first_gap_event_with(const WitnessMode& gap_mode, const 
   const Level first{opposite, zero}, second{back, back_start};
   const bool first_settles =
       turns_once && no_return_before_opposite_face(departure_sign(gap_mode, x0, *t0, noise), opposite_face_change);
+  // A quiet tail needs the motor free of the load (A(1, 2) = 0, the output at the motor): for the
+  // output at the load (cases III–VIII) the call is not made at all.
+  const bool motor_free = gap_mode.A.rows() == 4 && gap_mode.A(1, 2) == 0;
+  const double quiet_from =
+      motor_free ? quiet_gap_from(gap_mode.A, gap_mode.c, x0, opposite_face_change, 0, horizon, gap_mode.first_window)
+                 : INFINITY;
   const std::optional<LevelEvent> event =
-      first_of_two_levels(first, second, horizon, gap_mode.first_window, samples, first_settles);
+      first_of_two_levels(first, second, horizon, gap_mode.first_window, samples, first_settles, quiet_from);
   if (!event) return std::nullopt;
   if (event->second) return GapEvent{GapEventKind::FaceLeft, event->crossing, *t0, false, {}};
   const bool sampled_there = watch == event->crossing.t && at_watch.size() > 0;

@@ -66,16 +66,71 @@ struct MotorBlock {
 };
 
 // Whether A, c have the free mode's form (segment_dynamics.cpp, free_mode_segment), its rates ≥ 0.
-bool free_mode_form(const LinearSegment& s) {
-  const SmallMatrix& A = s.A;
-  if (A.rows() != 4 || A.cols() != 4 || s.c.size() != 4) return false;
+bool free_mode_form(const SmallMatrix& A, const SmallVector& c) {
+  if (A.rows() != 4 || A.cols() != 4 || c.size() != 4) return false;
   const bool fixed_rows = A(0, 0) == 0 && A(0, 1) == 1 && A(0, 2) == 0 && A(0, 3) == 0 && A(1, 3) == 0 &&
                           A(2, 0) == 0 && A(2, 1) == 0 && A(2, 2) == 0 && A(2, 3) == 1 && A(3, 0) == 0 &&
-                          A(3, 1) == 0 && A(3, 2) == 0 && s.c(0) == 0 && s.c(2) == 0 && s.c(3) == 0;
-  return fixed_rows && A(1, 0) <= 0 && A(1, 1) <= 0 && A(1, 2) <= 0 && A(3, 3) <= 0 && s.c.allFinite() && A.allFinite();
+                          A(3, 1) == 0 && A(3, 2) == 0 && c(0) == 0 && c(2) == 0 && c(3) == 0;
+  bool finite = true;  // (a loop: Eigen's allFinite on these dynamic sizes costs hundreds of instructions)
+  for (int i = 0; i < 16; ++i) finite = finite && std::isfinite(A.data()[i]);
+  for (int i = 0; i < 4; ++i) finite = finite && std::isfinite(c.data()[i]);
+  return fixed_rows && A(1, 0) <= 0 && A(1, 1) <= 0 && A(1, 2) <= 0 && A(3, 3) <= 0 && finite;
 }
+bool free_mode_form(const LinearSegment& s) { return free_mode_form(s.A, s.c); }
+
+// The gap change Δx(τ) = (θL − θm)(τ) − (θL − θm)(0) of the flight through x0 = x(0), for
+// τ ≥ τ0, within [low, high] (docs/design.md, "The event loop": a quiet tail).  With the motor not
+// driven by the load (A(1, 2) = 0) and under-damped (disc = α² − k < 0, ω = √−disc):
+//   θL(τ) − θL(0) = D(τ) = v0 (1 − e^{−βτ})/β (v0 τ for β = 0): monotone, between D(τ0) and D(h)
+//     for τ ∈ [τ0, h];
+//   θm(τ) − θm∞ = e^{−ατ}(y1 cos ωτ + (P/ω) sin ωτ), θm∞ = c/k, y1 = θm(0) − θm∞,
+//     P = α y1 + θ̇m(0): of modulus ≤ E(τ0) = e^{−ατ0} √(y1² + (P/ω)²) for τ ≥ τ0;
+// so Δx = D(τ) + y1 − (θm(τ) − θm∞) lies in [min(D(τ0), D(h)) + y1 − E, max(…) + y1 + E].
+struct GapTail {
+  double alpha, omega, beta, v0, y1, amplitude, margin, low, high, h, end_move;
+
+  // D(τ), its exponential rounded the safe way for the bound (e^{−βτ} up: D toward 0 is not
+  // safe in either direction, so the margin, ≥ 1e-6, covers the ulps of both).
+  double load_move(double tau) const { return beta > 0 ? -v0 * std::expm1(-beta * tau) / beta : v0 * tau; }
+  bool quiet_after(double tau0) const {
+    const double d0 = load_move(tau0), envelope = amplitude * decay(alpha, tau0);
+    return std::min(d0, end_move) + y1 - envelope > low + margin &&
+           std::max(d0, end_move) + y1 + envelope < high - margin;
+  }
+};
 
 }  // namespace
+
+double quiet_gap_from(const SmallMatrix& A, const SmallVector& c, const SmallVector& x0, double level_a,
+                      double level_b, double horizon, double first_window) {
+  // (the motor driven by the load — the output at the load, cases III–VIII — asked first: no tail)
+  if (A.rows() != 4 || A.cols() != 4 || A(1, 2) != 0 || !free_mode_form(A, c) || x0.size() != 4) return INFINITY;
+  if (!std::isfinite(x0(0)) || !std::isfinite(x0(1)) || !std::isfinite(x0(2)) || !std::isfinite(x0(3)) || !(horizon > 0))
+    return INFINITY;
+  const double k = -A(1, 0), alpha = -A(1, 1) / 2, disc = alpha * alpha - k;
+  if (!(k > 0) || !(disc < 0) || !(first_window > 0) || !std::isfinite(first_window)) return INFINITY;
+  GapTail g;
+  g.alpha = alpha;
+  g.omega = std::sqrt(-disc);
+  g.beta = -A(3, 3);
+  g.v0 = x0(3);
+  g.y1 = x0(0) - c(1) / k;
+  g.amplitude = std::hypot(g.y1, (alpha * g.y1 + x0(1)) / g.omega) * kUp;
+  g.low = std::min(level_a, level_b);
+  g.high = std::max(level_a, level_b);
+  g.h = horizon;
+  g.end_move = g.load_move(horizon);
+  const double scale = std::fabs(x0(0)) + std::fabs(x0(2)) + std::fabs(c(1) / k) + g.amplitude + std::fabs(g.end_move) +
+                       std::fabs(g.low) + std::fabs(g.high);
+  g.margin = kStateNoise * std::max(1.0, scale);
+  if (!g.quiet_after(horizon)) return INFINITY;  // not even the horizon's own state is clear: no tail
+  // The first of τ0 = 0, w/4, w/2, w, 2w, … that passes (the test is monotone in τ0: D(τ0) moves
+  // toward D(h) and E decays), so at most twice the earliest time that would.
+  if (g.quiet_after(0)) return 0;
+  for (double tau0 = first_window / 4; tau0 < horizon; tau0 *= 2)
+    if (g.quiet_after(tau0)) return tau0;
+  return horizon;
+}
 
 std::function<double(double, double)> gap_slope_third_derivative_bound(const LinearSegment& free_segment,
                                                                        const SmallVector& xT, double T) {

@@ -41,4 +41,19 @@ std::function<double(double, double)> gap_slope_third_derivative_bound(const Lin
 bool gap_moves_away_from(const LinearSegment& free_segment, const std::function<SmallVector(double)>& state,
                          double gap_at_from, double from, double horizon, double time_unit, long budget);
 
+/// A quiet tail of a free flight's gap (docs/design.md, "The event loop"): the earliest τ0 of
+/// 0, w/4, w/2, w, 2w, … (w = `first_window`, s) below `horizon` from which the gap change
+/// Δx(τ) = (θL − θm)(τ) − (θL − θm)(0) of the flight through x0 = x(0) = (θm, θ̇m, θL, θ̇L) on the
+/// free segment (A, c) stays strictly between the levels `level_a` and `level_b` (rad) for every
+/// τ in [τ0, horizon] — by more than a margin of 1e-6·max(1, the angles' size), far above the
+/// rounding and the validated closed forms' error (1e-9), so a search of the closed form over
+/// [τ0, horizon] finds no crossing of either level.  The proof is from the flight's exact modes:
+/// the load's position moves monotonically, θL(τ) − θL(0) = θ̇L(0)(1 − e^{−βτ})/β (β = FL/JL,
+/// θ̇L(0) τ for β = 0); the motor, not driven by the load (output at the motor) and under-damped
+/// (Fm² < 4 K Jm), swings about θm∞ = θR within e^{−ατ}√(y1² + ((α y1 + θ̇m(0))/ω)²)
+/// (α = Fm/(2Jm), ω² = K/Jm − α², y1 = θm(0) − θR).  INFINITY when no such τ0 is certified
+/// (another form of flight: the output at the load, a motor damped at least critically).
+double quiet_gap_from(const SmallMatrix& A, const SmallVector& c, const SmallVector& x0, double level_a,
+                      double level_b, double horizon, double first_window);
+
 }  // namespace backlash::numeric::detail

@@ -69,24 +69,11 @@ void expect_same(const std::optional<GapEvent>& windowed, const std::optional<Ga
   EXPECT_EQ(windowed->from_inside, sequential->from_inside) << label;
 }
 
-// A flight leaving the face σ after a bounce: both bodies at one velocity, the gap at σ b/2, its
-// relative acceleration away from the face (toward the opposite one).  Nothing when the draw
-// would press into the face.
-// Near θR (`near`: within 0.2 rad, at most 0.3 rad/s) the motor's swing is below b and the gap
-// mostly returns to the face; further out it mostly reaches the other.
+// A flight leaving the face σ after a bounce (flight_leaving_face).  Near θR (`near`: within
+// 0.2 rad, at most 0.3 rad/s) the motor's swing is below b and the gap mostly returns to the
+// face; further out it mostly reaches the other.
 std::optional<SmallVector> flight_after_bounce(const Parameters& p, std::mt19937_64& random, int& face, bool near = false) {
-  const double spread = near ? 0.2 : 2, max_speed = near ? 0.3 : 1.5;
-  std::uniform_real_distribution<double> angle(p.theta_R - spread, p.theta_R + spread), speed(-max_speed, max_speed);
-  face = random() % 2 ? 1 : -1;
-  SmallVector x(4);
-  const double v = speed(random);
-  x << angle(random), v, 0, v;
-  x(2) = x(0) + face * p.backlash / 2;
-  const LinearSegment free = free_mode_segment(p);
-  const SmallVector rate = free.A * x + free.c;
-  const double relative_acceleration = rate(3) - rate(1);  // Δx''(0): away from σ b/2 means sign −σ
-  if (!(relative_acceleration * face < 0)) return std::nullopt;
-  return x;
+  return backlash::testing::flight_leaving_face(p, random, face, near ? 0.2 : 2, near ? 0.3 : 1.5);
 }
 
 // The load's friction of the comparisons with the sequential searches: a horizon of 60·JL/FL =

@@ -6,11 +6,13 @@
 #pragma once
 
 #include "backlash/numeric/first_crossing.hpp"
+#include "backlash/numeric/segment_dynamics.hpp"
 #include "hybrid/gap_events.hpp"
 #include "hybrid/linear_flight.hpp"
 
 #include <algorithm>
 #include <optional>
+#include <random>
 
 namespace backlash::testing {
 
@@ -43,6 +45,24 @@ inline std::optional<numeric::detail::GapEvent> sequential_event(const numeric::
   if (back && (!opposite || back->t < opposite->t)) return GapEvent{GapEventKind::FaceLeft, *back, *t0, false, {}};
   if (opposite) return GapEvent{GapEventKind::OppositeFace, *opposite, 0, false, {}};
   return std::nullopt;
+}
+
+/// A flight leaving the face σ after a bounce (σ drawn): both bodies at one velocity, drawn within
+/// ±`max_speed`, θm within ±`spread` of θR, the gap at σ b/2, its relative acceleration away from
+/// the face (toward the opposite one).  Nothing when the draw would press into the face.
+inline std::optional<numeric::SmallVector> flight_leaving_face(const numeric::Parameters& p, std::mt19937_64& random,
+                                                               int& face, double spread, double max_speed) {
+  std::uniform_real_distribution<double> angle(p.theta_R - spread, p.theta_R + spread), speed(-max_speed, max_speed);
+  face = random() % 2 ? 1 : -1;
+  numeric::SmallVector x(4);
+  const double v = speed(random);
+  x << angle(random), v, 0, v;
+  x(2) = x(0) + face * p.backlash / 2;
+  const numeric::LinearSegment free = numeric::free_mode_segment(p);
+  const numeric::SmallVector rate = free.A * x + free.c;
+  const double relative_acceleration = rate(3) - rate(1);  // Δx''(0): away from σ b/2 means sign −σ
+  if (!(relative_acceleration * face < 0)) return std::nullopt;
+  return x;
 }
 
 }  // namespace backlash::testing
