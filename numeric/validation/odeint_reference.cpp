@@ -133,7 +133,7 @@ void check_complete(std::size_t computed, const std::vector<double>& times) {
 // odeint's integrate_times for a dense-output stepper (Boost 1.74,
 // boost/numeric/odeint/integrate/detail/integrate_times.hpp), the same calls in the same order,
 // except that `observe` returns false to end the run at that sample: no exception to unwind
-// (a map's gate stops some 1,600 free references at recombination).
+// (a map's gate ends most of its free references at recombination).
 template <class Stepper, class System, class Vector, class Observe>
 void integrate_times_while(Stepper& st, const System& system, Vector& x, const std::vector<double>& grid, double dt,
                            const Observe& observe) {
