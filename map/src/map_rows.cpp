@@ -11,6 +11,8 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace backlash::map {
 
@@ -23,6 +25,34 @@ void append_number(std::string& out, double value) {
   const auto result = std::to_chars(text, text + sizeof text, value);
   out.append(text, result.ptr);
 }
+
+// The texts of a row's numbers, column by column, kept from the row before on this thread: a
+// map's rows repeat most of their columns (the fixed parameters and effects, the slower axes),
+// and a number's text depends on its bits alone — a kept text is the one append_number writes.
+class ColumnTexts {
+ public:
+  void append(std::string& out, std::size_t column, double value) {
+    if (std::isnan(value)) return;
+    if (column >= kept_.size()) kept_.resize(column + 1);
+    Kept& k = kept_[column];
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &value, sizeof bits);
+    if (!k.valid || k.bits != bits) {
+      const auto result = std::to_chars(k.text, k.text + sizeof k.text, value);
+      k.length = static_cast<std::size_t>(result.ptr - k.text), k.bits = bits, k.valid = true;
+    }
+    out.append(k.text, k.length);
+  }
+
+ private:
+  struct Kept {
+    std::uint64_t bits = 0;
+    bool valid = false;
+    char text[32];
+    std::size_t length = 0;
+  };
+  std::vector<Kept> kept_;
+};
 
 void append_quoted(std::string& out, const std::string& text) {
   if (text.find_first_of(",\"\n\r") == std::string::npos) {
@@ -55,11 +85,14 @@ std::string map_csv_header(const MapPlan& plan) {
 }
 
 std::string map_csv_row(const MapRow& r) {
+  thread_local ColumnTexts texts;
+  std::size_t column = 0;
   std::string out = std::to_string(r.index);
-  for (const double x : r.x) out += ',', append_number(out, x);
+  out.reserve(400);
+  for (const double x : r.x) out += ',', texts.append(out, column++, x);
   const numeric::Parameters& p = r.row.point.parameters;
   const numeric::Effects& e = r.row.point.effects;
-  for (const double v : numeric::point_column_values(p, e)) out += ',', append_number(out, v);
+  for (const double v : numeric::point_column_values(p, e)) out += ',', texts.append(out, column++, v);
   const std::string status = api::status_of(r.row);
   const bool cycle = status == "limit_cycle";
   out += "," + status + ",";

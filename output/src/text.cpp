@@ -3,10 +3,26 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <stdexcept>
 #include <system_error>
+#include <version>
 
 namespace backlash::output {
+
+std::string printf_g(double value, int digits) {
+  if (digits < 1 || digits > 17) throw std::invalid_argument("printf_g: digits must be 1 ... 17");
+  char text[48];
+#if defined(__cpp_lib_to_chars)
+  if (std::isfinite(value)) {
+    const std::to_chars_result result = std::to_chars(text, text + sizeof text, value, std::chars_format::general, digits);
+    return std::string(text, result.ptr);
+  }
+#endif  // else the explorer's libc++ 14, which lacks it (explorer/src/libcxx_charconv.hpp): printf itself
+  std::snprintf(text, sizeof text, "%.*g", digits, value);
+  return text;
+}
 
 NumberText read_number(std::string_view text, double& value) {
   if (text.empty()) return NumberText::empty;

@@ -5,7 +5,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -30,11 +32,9 @@ std::string quoted(const std::string& text, bool keep_spaces = false) {
   return out + "'";
 }
 
-std::string number(double v) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof buffer, "%.10g", v);
-  return buffer;
-}
+// "%.10g" (output::printf_g: printf's bytes without printf's cost — a map's figures write
+// tens of thousands of numbers).
+std::string number(double v) { return output::printf_g(v, 10); }
 
 // cairo stamps its PDFs with the time of day: overwrite the digits in place (same length,
 // so the cross-reference offsets stay valid) with the epoch, for byte-reproducible files.
@@ -67,17 +67,22 @@ void preserve_svg_spaces(const std::filesystem::path& file) {
   {
     std::ifstream in(file, std::ios::binary);
     if (!in) return;
-    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    std::ostringstream all;  // in one read, not a character at a time (a map's SVG is a megabyte)
+    all << in.rdbuf();
+    bytes = std::move(all).str();
   }
   const std::string plain = "<text>", kept = "<text xml:space=\"preserve\">";
-  std::size_t replaced = 0;
-  for (std::size_t at = bytes.find(plain); at != std::string::npos; at = bytes.find(plain, at + kept.size())) {
-    bytes.replace(at, plain.size(), kept);
-    ++replaced;
+  std::string edited;
+  std::size_t from = 0;
+  for (std::size_t at = bytes.find(plain); at != std::string::npos; at = bytes.find(plain, from)) {
+    if (edited.empty()) edited.reserve(bytes.size() + bytes.size() / 16);
+    edited.append(bytes, from, at - from).append(kept);
+    from = at + plain.size();
   }
-  if (replaced == 0) return;
+  if (from == 0) return;  // nothing replaced
+  edited.append(bytes, from, std::string::npos);
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  out.write(edited.data(), static_cast<std::streamsize>(edited.size()));
 }
 
 // "%.6g": the value written at a bar's end.
@@ -122,6 +127,27 @@ namespace {
 
 // The inline data blocks of figure f: $d<f>_<i> per series (a blank line where a point is
 // not finite: a break in the line) and $h<f> for the heat map (x y xlow xhigh ylow yhigh value).
+// number(v) for values seen before, by their bits: a direct-mapped table of texts (a heat map
+// writes each grid edge and centre once per cell).  A number's text depends on its bits alone.
+class NumberTexts {
+ public:
+  const std::string& of(double v) {
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &v, sizeof bits);
+    Slot& s = slots_[(bits * 0x9e3779b97f4a7c15ULL) >> 54];  // 1024 slots
+    if (!s.used || s.bits != bits) s.text = number(v), s.bits = bits, s.used = true;
+    return s.text;
+  }
+
+ private:
+  struct Slot {
+    std::uint64_t bits = 0;
+    bool used = false;
+    std::string text;
+  };
+  std::vector<Slot> slots_ = std::vector<Slot>(1024);
+};
+
 void write_data_blocks(std::ostringstream& script, const Plot& plot, std::size_t f) {
   for (std::size_t i = 0; i < plot.series.size(); ++i) {
     const Series& s = plot.series[i];
@@ -142,6 +168,8 @@ void write_data_blocks(std::ostringstream& script, const Plot& plot, std::size_t
   }
   if (!plot.heat_map) return;
   const HeatMap& h = *plot.heat_map;
+  NumberTexts texts;  // a grid's cells repeat their edges and centres
+  const auto number = [&texts](double v) -> const std::string& { return texts.of(v); };
   script << "$h" << f << " << EOD\n";
   for (std::size_t k = 0; k < h.value.size() && k < h.x_low.size() && k < h.x_high.size() && k < h.y_low.size() && k < h.y_high.size(); ++k) {
     if (!std::isfinite(h.value[k])) continue;

@@ -1,17 +1,22 @@
 // check_output_text — the text helpers shared by the writers and readers
 // (backlash/output/text.hpp): read_number against the rules of the flags and CSV cells,
-// toml_string and shell_word on hostile text.
+// printf_g against printf itself on random doubles, toml_string and shell_word on hostile text.
 #include "backlash/output/text.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <random>
 #include <limits>
 #include <string>
 
 namespace {
 
 using backlash::output::NumberText;
+using backlash::output::printf_g;
 using backlash::output::read_number;
 using backlash::output::shell_word;
 using backlash::output::toml_string;
@@ -42,6 +47,41 @@ TEST(ReadNumber, NamesWhatIsWrong) {
   for (const char* text : {"1e400", "-1e400"}) EXPECT_EQ(status(text), NumberText::too_large) << text;
   for (const char* text : {"1e-400", "-1e-400"}) EXPECT_EQ(status(text), NumberText::too_small) << text;
   for (const char* text : {"nan", "inf", "-inf", "+Infinity", "NAN"}) EXPECT_EQ(status(text), NumberText::not_finite) << text;
+}
+
+std::string printf_text(double value, int digits) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.*g", digits, value);
+  return text;
+}
+
+// Random bit patterns (every exponent: subnormals, huge values, inf and nan), values on a decimal
+// grid (where rounding ties to the printed digit sit), and small integers, at every precision:
+// printf_g writes printf's bytes.
+TEST(PrintfG, WritesPrintfsBytes) {
+  std::mt19937_64 random(20261128);
+  std::uniform_int_distribution<int> precision(1, 17);
+  long compared = 0;
+  for (int k = 0; k < 300000; ++k) {
+    double value = 0;
+    const std::uint64_t bits = random();
+    switch (k % 3) {
+      case 0: std::memcpy(&value, &bits, sizeof value); break;
+      case 1: value = static_cast<double>(static_cast<std::int64_t>(bits % 2000001) - 1000000) / 1000.0; break;
+      default: value = std::ldexp(static_cast<double>(bits >> 40), static_cast<int>(bits % 64) - 32); break;
+    }
+    const int digits = k % 5 == 0 ? 10 : precision(random);
+    ASSERT_EQ(printf_g(value, digits), printf_text(value, digits)) << "digits " << digits << " bits " << bits;
+    ++compared;
+  }
+  for (const double value : {0.0, -0.0, 1e-5, 1e-4, 0.5, 1e15, 1e16, 1e17, 123456789.5, 0.30000000000000004,
+                             std::numeric_limits<double>::denorm_min(), std::numeric_limits<double>::max(),
+                             std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+                             std::numeric_limits<double>::quiet_NaN(), -std::numeric_limits<double>::quiet_NaN()})
+    for (int digits = 1; digits <= 17; ++digits) EXPECT_EQ(printf_g(value, digits), printf_text(value, digits)) << value;
+  EXPECT_EQ(compared, 300000);
+  EXPECT_THROW(printf_g(1.0, 0), std::invalid_argument);
+  EXPECT_THROW(printf_g(1.0, 18), std::invalid_argument);
 }
 
 TEST(TomlString, StaysOneValidLine) {

@@ -1,6 +1,7 @@
 // backlash/output/text.hpp — small text helpers shared by the writers and readers, written
-// once: a number read from a whole text (flags, CSV cells), a TOML basic string (case files)
-// and a POSIX shell word (the commands run for gnuplot and pdflatex).
+// once: a number read from a whole text (flags, CSV cells), a number written as printf's "%.Ng"
+// writes it (gnuplot's data), a TOML basic string (case files) and a POSIX shell word (the
+// commands run for gnuplot and pdflatex).
 #pragma once
 
 #include <string>
@@ -21,6 +22,12 @@ enum class NumberText {
 /// Reads all of `text` as a decimal double, correctly rounded (std::from_chars, general
 /// format; a leading '+' is allowed).  `value` is set only when the result is ok or not_finite.
 NumberText read_number(std::string_view text, double& value);
+
+/// The text std::printf("%.<digits>g", value) gives in the C locale, digits 1 … 17 — the same
+/// bytes, at a fraction of printf's cost: std::to_chars in general format with that precision,
+/// which the standard defines as printf's conversion (finite values; inf and nan go through
+/// snprintf itself).
+std::string printf_g(double value, int digits);
 
 /// A TOML basic string holding `text`: in double quotes, '"' and '\' escaped, control
 /// characters (below 0x20, and DEL) dropped so the string stays on one line and valid.
