@@ -52,7 +52,9 @@ double horizon_of(const Parameters& p, const Effects& e, const Mode& m, const Ef
   return horizon;
 }
 
-ModeValidation validate_mode(const Parameters& p, const Effects& e, const Mode& m, const EffectValidationOptions& o) {
+// `references`, if given, keeps the reference integrations (the same bits as integrating anew).
+ModeValidation validate_mode(const Parameters& p, const Effects& e, const Mode& m, const EffectValidationOptions& o,
+                             LinearReferenceCache* references) {
   ModeValidation v;
   v.mode = m;
   const double horizon = horizon_of(p, e, m, o);
@@ -62,7 +64,8 @@ ModeValidation validate_mode(const Parameters& p, const Effects& e, const Mode& 
     const ModeFlow flow(p, e, m, start);
     v.matrix_exponential = v.matrix_exponential || flow.uses_matrix_exponential();
     const std::vector<SmallVector> reference =
-        reference_linear_trajectory(flow.segment(), flow.local_start(), times, o.odeint_tolerance);
+        references ? references->trajectory(flow.segment(), flow.local_start(), times, o.odeint_tolerance)
+                   : reference_linear_trajectory(flow.segment(), flow.local_start(), times, o.odeint_tolerance);
     for (std::size_t i = 0; i < times.size(); ++i) {
       const SmallVector z = flow.local(times[i]);
       // Absolute error, relative to the trajectory's size where it grows beyond 1.
@@ -77,6 +80,18 @@ ModeValidation validate_mode(const Parameters& p, const Effects& e, const Mode& 
   }
   v.passed = v.max_abs_error <= o.tolerance;
   return v;
+}
+
+// Every reachable mode of (p, effects) validated (none for no effects or a delay).
+EffectValidationReport effects_report(const Parameters& p, const Effects& effects, const EffectValidationOptions& options,
+                                      LinearReferenceCache* references) {
+  EffectValidationReport report;
+  report.effects = effects;
+  report.tolerance = options.tolerance;
+  if (effects.any() && !effects.delayed())
+    for (const Mode& m : reachable_modes(p, effects)) report.modes.push_back(validate_mode(p, effects, m, options, references));
+  report.passed = std::all_of(report.modes.begin(), report.modes.end(), [](const ModeValidation& m) { return m.passed; });
+  return report;
 }
 
 }  // namespace
@@ -108,12 +123,7 @@ EffectValidationResult validate_effects(const ValidatedEvaluator& nominal, const
                                         const EffectValidationOptions& options) {
   EffectValidationResult result;
   EffectValidationReport& report = result.report_;
-  report.effects = effects;
-  report.tolerance = options.tolerance;
-  const Parameters& p = nominal.parameters();
-  if (effects.any() && !effects.delayed())
-    for (const Mode& m : reachable_modes(p, effects)) report.modes.push_back(validate_mode(p, effects, m, options));
-  report.passed = std::all_of(report.modes.begin(), report.modes.end(), [](const ModeValidation& m) { return m.passed; });
+  report = effects_report(nominal.parameters(), effects, options, nullptr);
   if (report.passed) result.validated_ = ValidatedEffectModel(nominal, effects, report);
   return result;
 }
@@ -139,7 +149,8 @@ bool ValidatedModelFamily::validate_samples(const std::vector<std::pair<Paramete
   for (const auto& [p, e] : samples) {
     const std::string key = structure(e);
     const std::optional<ValidatedEvaluator> nominal = nominal_.at(p);
-    const bool passed = nominal && validate_effects(*nominal, e, options_).passed();
+    // The gate of validate_effects, its reference integrations kept across the family's samples.
+    const bool passed = nominal && effects_report(nominal->parameters(), e, options_, &references_).passed;
     std::lock_guard<std::mutex> lock(mutex_);
     ++validated_;
     if (!passed) {

@@ -29,6 +29,7 @@
 #include "backlash/numeric/effects_engine_options.hpp"
 #include "backlash/numeric/hybrid_simulation.hpp"
 #include "backlash/numeric/mode.hpp"
+#include "backlash/numeric/reference.hpp"
 #include "backlash/numeric/validated_family.hpp"
 #include "backlash/numeric/validation.hpp"
 
@@ -130,6 +131,8 @@ class ValidatedModelFamily {
   static std::vector<double> coordinates(const Parameters& p, const Effects& e);
   ValidatedParametricFamily nominal_;
   EffectValidationOptions options_;
+  /// The gate's reference integrations, kept by their exact inputs (the same verdicts, bit for bit).
+  LinearReferenceCache references_;
   mutable std::mutex mutex_;
   std::map<std::string, Box> boxes_;
   std::set<std::string> failed_;

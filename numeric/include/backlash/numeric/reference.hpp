@@ -14,7 +14,12 @@
 #include "backlash/numeric/parametric.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
 
+#include <cstddef>
+#include <deque>
 #include <functional>
+#include <map>
+#include <mutex>
+#include <string>
 #include <vector>
 
 namespace backlash::numeric {
@@ -37,5 +42,30 @@ ContactState reference_contact_state(const Parameters& p, double theta_o0, doubl
 /// Any linear mode z' = A z + c (the effect modes of numeric/effects/effect_modes.hpp) from z0, at `times`.
 std::vector<SmallVector> reference_linear_trajectory(const LinearSegment& segment, const SmallVector& z0,
                                                      const std::vector<double>& times, double tolerance = 1e-12);
+
+/// reference_linear_trajectory's results kept by their exact inputs — the bits of A, c, z0, the
+/// times and the tolerance (and their sizes): the integration is deterministic, so what it hands
+/// back is what a new integration of the same inputs gives, bit for bit.  The effects gate of a
+/// family of models (ValidatedModelFamily) meets the same mode from the same start at many model
+/// points: a mode's z' = A z + c leaves out the effects it does not feel, so a candidate's range
+/// corners beside another base repeat most of its flows (≈ 80 % of the discrepancy workflow's
+/// reference integrations, bench/README.md "Speed at the limit").  Thread-safe; keeps the last
+/// `capacity` inputs (≈ 6 kB each at the gate's 120 times).
+class LinearReferenceCache {
+ public:
+  explicit LinearReferenceCache(std::size_t capacity = 2048) : capacity_(capacity) {}
+  /// reference_linear_trajectory(segment, z0, times, tolerance), kept or integrated.
+  std::vector<SmallVector> trajectory(const LinearSegment& segment, const SmallVector& z0, const std::vector<double>& times,
+                                      double tolerance);
+  long hits() const;
+  long integrations() const;
+
+ private:
+  std::size_t capacity_;
+  mutable std::mutex mutex_;
+  std::map<std::string, std::vector<SmallVector>> kept_;
+  std::deque<std::string> order_;  ///< oldest first
+  long hits_ = 0, integrations_ = 0;
+};
 
 }  // namespace backlash::numeric
