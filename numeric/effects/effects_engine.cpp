@@ -1,5 +1,6 @@
 // The event loop of the hybrid model with effects (effects_engine.hpp, docs/effects.md).
 #include "effects/effects_engine.hpp"
+#include "hybrid/gap_events.hpp"
 #include "hybrid/rest_search.hpp"
 
 
@@ -124,6 +125,18 @@ void mode_witnesses(const Parameters& p, const Effects& e, const Mode& m, const 
     case ModeKind::Mesh: mesh_witnesses(p, e, m, f, out); break;
   }
   if (with_drive_limits) drive_limit_witnesses(p, e, m, f, out);
+}
+
+// The gap rate's annihilating polynomial (docs/effects.md, "A flight whose gap turns at most
+// once"): a stuck motor's velocity is 0, a clipped drive's motor solves D(D + Fm/Jm)θ̇m = 0; the
+// load solves (D + FL/JL)θ̇L = 0, D(D + FL/JL)θ̇L = 0 with its Coulomb torque, θ̇L = 0 stuck.  A
+// linear drive adds the nominal flight's factor (gap_rate_turns_at_most_once) — times the load's
+// extra root at 0 when the load slips with a Coulomb torque, which makes the degree 4.
+bool free_gap_turns_once(const Parameters& p, const Effects& e, const Mode& m) {
+  if (m.kind != ModeKind::Free || e.compliant() || e.delayed() || e.stribeck() || !(p.backlash > 0)) return false;
+  if (m.slip_motor == 0 || m.regime != 0) return true;
+  if (m.slip_load != 0 && e.coulomb_load > 0) return false;
+  return gap_rate_turns_at_most_once(p);
 }
 
 std::vector<Witness> mode_witnesses(const Parameters& p, const Effects& e, const Mode& m, const ModeFunctionals& f,

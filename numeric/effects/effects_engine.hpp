@@ -169,12 +169,33 @@ WitnessMode witness_mode(const SmallMatrix& A, const SmallVector& c, const Small
 /// call on this thread (copy it to keep it).
 const WitnessMode& kept_witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e);
 
+/// Whether the gap rate θ̇L − θ̇m of a free flight in mode `m` of the closed-form engine (rigid
+/// gear: no compliance, delay or Stribeck friction) has at most two real zeros, counted with
+/// multiplicity (docs/effects.md, "A flight whose gap turns at most once"): each body's velocity
+/// solves a linear ODE whose added torques are constant over the mode (the offset T0, a clipped
+/// drive ±L, the Coulomb torques −T·s), and the gap rate is annihilated by a polynomial in D of
+/// degree ≤ 3 with real roots when
+///   - the motor is stuck, or its drive is clipped (D(D + Fm/Jm) for the motor), or
+///   - the load has no Coulomb torque (or is stuck) and the nominal flight has the property
+///     (gap_rate_turns_at_most_once: the output at the load, or an over-damped motor);
+/// not with a slipping load's Coulomb torque and a linear drive (degree 4: D²(D + FL/JL)(D + Fm/Jm)
+/// at the load, D(D + FL/JL)(D² + (Fm/Jm)D + K/Jm) at the motor).
+bool free_gap_turns_once(const Parameters& p, const Effects& e, const Mode& m);
+
+/// Whether a closed-form segment leaves out the search for the return to the face a flight left
+/// before the opposite face's crossing (docs/effects.md, "A flight whose gap turns at most once"):
+/// `Proved` where free_gap_turns_once holds and the flight starts with one velocity for both
+/// bodies, `Off` never; `Forced` wherever the two gap guards are searched (tests only: where the
+/// proof does not hold it misses returns).
+enum class OneTurn { Proved, Off, Forced };
+
 /// The closed-form segment of mode `m` from `start` (effects_simulation.cpp) with `extra` guards
 /// besides the mode's own (Handover guards: their exit ends the segment without an exit);
 /// `left_zone` as ModeFunctionals::left_zone.
 std::unique_ptr<Segment> closed_form_segment(const Parameters& p, const Effects& e, const Mode& m,
                                              const HybridState& start, double horizon, double t_global,
-                                             int left_zone, const std::vector<Witness>& extra);
+                                             int left_zone, const std::vector<Witness>& extra,
+                                             OneTurn one_turn = OneTurn::Proved);
 
 /// Stribeck friction (dopri5 with exact event semantics): effects_stribeck.cpp.
 SimulationResult simulate_stribeck(const Parameters& p, const Effects& e, const HybridState& start,

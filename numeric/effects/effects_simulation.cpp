@@ -94,6 +94,7 @@ enum class StartKind { Inside, ExitNow, Never };
 struct Start {
   StartKind kind = StartKind::Inside;
   double from = 0;
+  bool departs = false;  ///< on the boundary, leaving toward w > 0, certified w(from) > 0 (departure_time)
 };
 
 // Where the search for a witness's exit starts.  Rounding scales come from the size of the
@@ -133,7 +134,8 @@ Start classify_start(const ModeFlow& flow, const WitnessMode& mode, double level
     if (std::fabs(w[K]) <= 1e-9 * scale[K]) continue;
     if (w[K] < 0) return {StartKind::ExitNow, 0};
     const double from = departure_time(A, e, zdot, w, K, horizon);
-    return {StartKind::Inside, from > 0 ? from : std::min(horizon, 1e-12 * std::max(1.0, horizon))};
+    if (from > 0) return {StartKind::Inside, from, true};
+    return {StartKind::Inside, std::min(horizon, 1e-12 * std::max(1.0, horizon))};
   }
   return {StartKind::Never, 0};
 }
@@ -239,9 +241,13 @@ class ExitSearch {
     if (start.kind == StartKind::Never) finished_ = true;
     if (start.kind == StartKind::ExitNow) immediate_ = true;
     from_ = start.from;
+    departs_ = start.departs;
   }
 
   bool immediate() const { return immediate_; }
+  /// The witness starts on its boundary and leaves it toward w > 0, w(τ) > 0 certified where its
+  /// search starts (classify_start).
+  bool departs() const { return departs_; }
 
   /// The first exit in (from, until], or nothing there (the search then resumes at `until`).
   std::optional<Exit> search_until(double until) {
@@ -281,13 +287,56 @@ class ExitSearch {
   std::function<double(double, double)> bound_;  // the stiff flow's bound on |w'''| (mesh modes), or empty
   const WitnessMode* mode_ = nullptr;  // the witness's constants
   double from_ = 0;
-  bool finished_ = false, immediate_ = false;
+  bool finished_ = false, immediate_ = false, departs_ = false;
 };
+
+// Whether a free flight's return to the face left is not searched before the opposite face's
+// crossing (detail::OneTurn): the mode's gap rate has at most two real zeros
+// (free_gap_turns_once), one of them the start (both bodies at one velocity in the flow's own
+// start, so the gap rate is exactly 0 there), and the flight leaves the face toward the opposite
+// one; the opposite face's guard is searched first in every window (docs/effects.md).
+bool one_turn_applies(detail::OneTurn one_turn, const Parameters& p, const Effects& e, const ModeFlow& flow,
+                      const std::vector<Witness>& witnesses, const std::vector<ExitSearch>& searches) {
+  if (one_turn == detail::OneTurn::Off || witnesses.size() < 2) return false;
+  if (witnesses[0].guard != Guard::GapOpposite || witnesses[1].guard != Guard::GapSame || !searches[1].departs())
+    return false;
+  if (one_turn == detail::OneTurn::Forced) return true;
+  const SmallVector& z0 = flow.local_start();  // (Δm, θ̇m, ΔL, θ̇L)
+  return detail::free_gap_turns_once(p, e, flow.mode()) && z0(1) == z0(3);
+}
+
+// The first exit of a free flight whose gap turns at most once (one_turn_applies), as the
+// segment's loop over the windows finds it (ClosedFormSegment): searches[0], the opposite face's
+// guard, is first in every window and so asked up to each window's end, whatever the others find:
+// searched ahead alone it is asked exactly what the loop would ask.  When it finds a crossing,
+// the return's guard searches[1] is left out up to it: every range the loop would ask it lies
+// before that crossing, where the gap is proved not to return (docs/effects.md, "A flight whose
+// gap turns at most once"); without a crossing, searches[1] is searched as in the loop.
+[[gnu::noinline]] std::optional<Exit> first_exit_one_turn(std::vector<ExitSearch>& searches, double horizon,
+                                                          double first_window) {
+  std::optional<Exit> ahead, exit;
+  int ahead_window = -1, j = 0;
+  double window = first_window;
+  for (double a = 0; a < horizon && !ahead; a += window, window *= 2, ++j)
+    if ((ahead = searches[0].search_until(std::min(horizon, a + window)))) ahead_window = j;
+  window = first_window;
+  j = 0;
+  for (double a = 0; a < horizon && !exit; a += window, window *= 2, ++j) {
+    const double b = std::min(horizon, a + window);
+    if (j == ahead_window) exit = ahead;
+    for (std::size_t i = ahead ? 2 : 1; i < searches.size(); ++i) {
+      const std::optional<Exit> candidate = searches[i].search_until(exit ? exit->tau : b);
+      if (candidate && (!exit || candidate->tau < exit->tau)) exit = candidate;
+    }
+  }
+  return exit;
+}
 
 class ClosedFormSegment final : public detail::Segment {
  public:
   ClosedFormSegment(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start, double horizon,
-                    double t_global, int left_zone, const std::vector<Witness>& extra = {})
+                    double t_global, int left_zone, const std::vector<Witness>& extra = {},
+                    detail::OneTurn one_turn = detail::OneTurn::Proved)
       : params_(p), flow_(p, e, m, start) {
     duration = horizon;
     if (m.kind == ModeKind::Contact ? m.slip_motor == 0 : (m.slip_motor == 0 && m.slip_load == 0)) {
@@ -315,6 +364,7 @@ class ClosedFormSegment final : public detail::Segment {
       }
     }
     double window = std::min(horizon, 0.125 * servo_period(p));
+    if (one_turn_applies(one_turn, p, e, flow_, witnesses, searches)) exit = first_exit_one_turn(searches, horizon, window);
     for (double a = 0; a < horizon && !exit; a += window, window *= 2) {
       const double b = std::min(horizon, a + window);
       for (ExitSearch& search : searches) {
@@ -378,8 +428,8 @@ class ClosedFormEngine final : public detail::Engine {
 std::unique_ptr<detail::Segment> detail::closed_form_segment(const Parameters& p, const Effects& e, const Mode& m,
                                                              const HybridState& start, double horizon,
                                                              double t_global, int left_zone,
-                                                             const std::vector<Witness>& extra) {
-  return std::make_unique<ClosedFormSegment>(p, e, m, start, horizon, t_global, left_zone, extra);
+                                                             const std::vector<Witness>& extra, detail::OneTurn one_turn) {
+  return std::make_unique<ClosedFormSegment>(p, e, m, start, horizon, t_global, left_zone, extra, one_turn);
 }
 
 SimulationResult simulate_effects(const ValidatedEffectModel& model, const HybridState& start,

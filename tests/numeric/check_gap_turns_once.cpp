@@ -10,6 +10,7 @@
 // and with the property it costs fewer samples.
 #include "backlash/numeric/first_crossing.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
+#include "gap_turns_once_parameters.hpp"
 #include "hybrid/gap_events.hpp"
 #include "hybrid/linear_flight.hpp"
 #include "sequential_gap_event.hpp"
@@ -27,25 +28,7 @@ using namespace backlash::numeric;
 using detail::GapEvent;
 using detail::GapEventKind;
 
-// A random parameter set: the output at the load (any damping), or at the motor with the motor
-// over-damped (`kind` 1) or under-damped (`kind` 2).  The nominal model's under-damped motors
-// (Fm ≥ 0) were not seen to return before the opposite face's crossing (nor is it proved they
-// cannot): `kind` 2 draws a negative Fm (swings that grow, with a narrow backlash), which does —
-// flights on which the shortcut, forced, must be caught missing the return.
-Parameters random_parameters(std::mt19937_64& random, int kind) {
-  std::uniform_real_distribution<double> inertia(0.1, 1.0), friction(0.0, 0.5), gap(0.05, 0.5), over(1.05, 3.0);
-  Parameters p;
-  p.K = 1;
-  p.theta_R = 1;
-  p.Jm = inertia(random);
-  p.JL = inertia(random);
-  p.FL = friction(random);
-  p.backlash = kind == 2 ? 0.2 * gap(random) : gap(random);  // under-damped: swings past the backlash
-  p.measured_at = kind == 0 ? model::MeasuredAt::Load : model::MeasuredAt::Motor;
-  const double critical = std::sqrt(4 * p.K * p.Jm);
-  p.Fm = kind == 1 ? over(random) * critical : kind == 2 ? -0.5 * critical * friction(random) : friction(random);
-  return p;
-}
+using backlash::testing::random_gap_parameters;
 
 // A flight leaving the face σ at one velocity for both bodies, its relative acceleration toward the
 // opposite face; nothing when the draw presses into the face.
@@ -101,7 +84,7 @@ struct Tally {
 void run_flights(int kind, bool forced, int sets, Tally& tally) {
   std::mt19937_64 random(1900 + kind);
   for (int set = 0; set < sets; ++set) {
-    const Parameters p = random_parameters(random, kind);
+    const Parameters p = random_gap_parameters(random, kind);
     ASSERT_EQ(detail::gap_rate_turns_at_most_once(p), kind != 2);
     const double horizon = 20 * slowest_time_scale(p);
     const WitnessMode mode = detail::gap_witness_mode(free_mode_segment(p), servo_time_unit(p));
