@@ -3,9 +3,9 @@
 
 #include <boost/numeric/odeint.hpp>
 
-#include <algorithm>
 #include <array>
-#include <cstring>
+#include <iterator>
+#include <string>
 #include <functional>
 #include <stdexcept>
 #include <type_traits>
@@ -30,15 +30,6 @@ struct FreeSystem {
   }
 };
 
-// a and b hold the same bits (−0 is not 0 here, and a NaN is its own bits).
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
-
-bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
-}
-
-// Everything the contact mode reads of the parameters: K, θR, F = Fm + FL, J = Jm + JL (the
-// sums rounded once, as the expression below always rounded them).
 struct ContactSystem {
   double K, theta_R, F, J;
   explicit ContactSystem(const Parameters& p) : K(p.K), theta_R(p.theta_R), F(p.Fm + p.FL), J(p.Jm + p.JL) {}
@@ -46,46 +37,6 @@ struct ContactSystem {
     dx[0] = x[1];
     dx[1] = (K * (theta_R - x[0]) - F * x[1]) / J;
   }
-  bool same(const ContactSystem& o) const {
-    return same_bits(K, o.K) && same_bits(theta_R, o.theta_R) && same_bits(F, o.F) && same_bits(J, o.J);
-  }
-};
-
-// The contact references computed last on this thread, by their whole input: the system (its
-// four numbers), the start, the times and the tolerance.  The reference is a function of that
-// input alone (the same stepper, the same operations), so a hit returns the same bits.  A map's
-// gate validates many parameter sets with the same Jm + JL, Fm + FL and K (JL_over_Jm and
-// FL_over_F keep the sums): four of its seven contact starts (at rest and moving, off θR) are the
-// same for all of them.  Bit-for-bit comparisons only.
-class ContactMemo {
- public:
-  const std::vector<ContactState>* find(const ContactSystem& s, double x0, double v0, const std::vector<double>& times,
-                                        double tolerance) {
-    for (std::size_t i = 0; i < entries_.size(); ++i) {
-      const Entry& e = entries_[i];
-      if (e.system.same(s) && same_bits(e.x0, x0) && same_bits(e.v0, v0) && same_bits(e.tolerance, tolerance) &&
-          same_bits(e.times, times)) {
-        std::rotate(entries_.begin(), entries_.begin() + static_cast<long>(i), entries_.begin() + static_cast<long>(i) + 1);
-        return &entries_.front().states;  // the most recently used first
-      }
-    }
-    return nullptr;
-  }
-  void keep(const ContactSystem& s, double x0, double v0, const std::vector<double>& times, double tolerance,
-            const std::vector<ContactState>& states) {
-    if (entries_.size() == kEntries) entries_.pop_back();
-    entries_.insert(entries_.begin(), Entry{s, x0, v0, tolerance, times, states});
-  }
-
- private:
-  static constexpr std::size_t kEntries = 8;
-  struct Entry {
-    ContactSystem system;
-    double x0, v0, tolerance;
-    std::vector<double> times;
-    std::vector<ContactState> states;
-  };
-  std::vector<Entry> entries_;
 };
 
 void check_times(const std::vector<double>& times) {
@@ -124,37 +75,13 @@ std::vector<double> scaled_grid(const std::vector<double>& times, double unit, b
   return grid;
 }
 
+// Thrown by the observer once the caller's `until` holds: the integration ends at that sample.
+struct Reached {};
+
 void check_complete(std::size_t computed, const std::vector<double>& times) {
   if (computed != times.size())
     throw std::runtime_error("reference trajectory: odeint stopped after " + std::to_string(computed) + " of " +
                              std::to_string(times.size()) + " times");
-}
-
-// odeint's integrate_times for a dense-output stepper (Boost 1.74,
-// boost/numeric/odeint/integrate/detail/integrate_times.hpp), the same calls in the same order,
-// except that `observe` returns false to end the run at that sample: no exception to unwind
-// (a map's gate ends most of its free references at recombination).
-template <class Stepper, class System, class Vector, class Observe>
-void integrate_times_while(Stepper& st, const System& system, Vector& x, const std::vector<double>& grid, double dt,
-                           const Observe& observe) {
-  using odeint::detail::less_eq_with_sign;
-  if (grid.empty()) return;
-  const double last = grid.back();
-  auto t = grid.begin();
-  st.initialize(x, *t, dt);
-  if (!observe(x)) return;
-  for (++t; t != grid.end();) {
-    for (; t != grid.end() && less_eq_with_sign(*t, st.current_time(), st.current_time_step()); ++t) {
-      st.calc_state(*t, x);
-      if (!observe(x)) return;
-    }
-    if (less_eq_with_sign(st.current_time() + st.current_time_step(), last, st.current_time_step())) {
-      st.do_step(system);
-    } else if (t != grid.end()) {  // the last step, ending exactly on the last time
-      st.initialize(st.current_state(), st.current_time(), last - st.current_time());
-      st.do_step(system);
-    }
-  }
 }
 
 // The states at `times`; with `until`, only up to the first state for which it holds (the
@@ -167,7 +94,7 @@ auto integrate(const System& system, Vector x0, const std::vector<double>& times
   std::vector<Out> out;
   out.reserve(times.size());
   if (times.empty()) return out;
-  // The run starts at the first time: begin at 0 and drop that sample if not asked for.
+  // integrate_times starts at the first time: begin at 0 and drop that sample if not asked for.
   const double unit = time_unit(times);
   bool skip = false;
   const std::vector<double> grid = scaled_grid(times, unit, skip);
@@ -176,15 +103,21 @@ auto integrate(const System& system, Vector x0, const std::vector<double>& times
     for (double& d : dx) d *= unit;
   };
   auto stepper = odeint::make_dense_output(tolerance, tolerance, odeint::runge_kutta_dopri5<Vector>());
-  bool reached = false;
-  integrate_times_while(stepper, scaled, x0, grid, initial_step(grid), [&](const Vector& x) {
-    if (skip) return !(skip = false);
-    out.push_back(convert(x));
-    if constexpr (!std::is_null_pointer_v<Until>)
-      if (until && until(out.back())) reached = true;
-    return !reached;
-  });
-  if (!reached) check_complete(out.size(), times);
+  try {
+    odeint::integrate_times(stepper, scaled, x0, grid.begin(), grid.end(), initial_step(grid),
+                            [&](const Vector& x, double) {
+                              if (skip) {
+                                skip = false;
+                                return;
+                              }
+                              out.push_back(convert(x));
+                              if constexpr (!std::is_null_pointer_v<Until>)
+                                if (until && until(out.back())) throw Reached{};
+                            });
+  } catch (const Reached&) {
+    return out;
+  }
+  check_complete(out.size(), times);
   return out;
 }
 
@@ -206,13 +139,18 @@ std::vector<FreeState> reference_free_trajectory(const Parameters& p, double v0,
 
 std::vector<ContactState> reference_contact_trajectory(const Parameters& p, double theta_o0, double dtheta_o0,
                                                        const std::vector<double>& times, double tolerance) {
-  thread_local ContactMemo memo;
+  // Kept per thread by the whole input: a map's gate validates many parameter sets with the same
+  // K, θR, Fm + FL and Jm + JL (JL_over_Jm and FL_over_F keep the sums), and four of its seven
+  // contact starts are then the same runs.
+  thread_local KeptByBits<std::vector<ContactState>> kept(8);
   const ContactSystem system(p);
-  if (const std::vector<ContactState>* kept = memo.find(system, theta_o0, dtheta_o0, times, tolerance)) return *kept;
-  std::vector<ContactState> states =
-      integrate<ContactVector>(system, ContactVector{theta_o0, dtheta_o0}, times, tolerance, &contact_from);
-  memo.keep(system, theta_o0, dtheta_o0, times, tolerance, states);
-  return states;
+  const double numbers[] = {system.K, system.theta_R, system.F, system.J, theta_o0, dtheta_o0, tolerance};
+  std::string key;
+  append_bits(key, numbers, std::size(numbers));
+  append_bits(key, times.data(), times.size());
+  return kept.get(std::move(key), [&] {
+    return integrate<ContactVector>(system, ContactVector{theta_o0, dtheta_o0}, times, tolerance, &contact_from);
+  });
 }
 
 FreeState reference_free_state(const Parameters& p, double v0, double t, double tolerance) {

@@ -1,10 +1,9 @@
 // check_reference_reuse — the gate's odeint references (numeric/reference.hpp) as the map's gate
-// reuses them: (1) the run that stops at a sample (the free mode at recombination) takes odeint's
-// integrate_times steps, call for call: its states are those of Boost.Odeint's own
-// integrate_times on the same stepper, bit for bit, on random systems; (2) a contact reference
-// kept from an earlier call on the thread (a hit) is the same bits as one computed afresh on a new
-// thread, and an input that differs in any one number (one part in 1e9, or −0 for 0) is not
-// taken for a kept one.
+// reuses them: (1) the reference run, whole or stopped at a sample (the free mode at
+// recombination), is Boost.Odeint's own integrate_times on the same stepper, bit for bit, on
+// random systems; (2) a contact reference kept from an earlier call on the thread (a hit) is the
+// same bits as one computed afresh on a new thread, and an input that differs in any one number
+// (one part in 1e9, or −0 for 0) is not taken for a kept one.
 #include "backlash/numeric/parameters.hpp"
 #include "backlash/numeric/parametric.hpp"
 #include "backlash/numeric/reference.hpp"

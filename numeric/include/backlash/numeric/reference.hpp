@@ -43,29 +43,77 @@ ContactState reference_contact_state(const Parameters& p, double theta_o0, doubl
 std::vector<SmallVector> reference_linear_trajectory(const LinearSegment& segment, const SmallVector& z0,
                                                      const std::vector<double>& times, double tolerance = 1e-12);
 
-/// reference_linear_trajectory's results kept by their exact inputs — the bits of A, c, z0, the
-/// times and the tolerance (and their sizes): the integration is deterministic, so what it hands
-/// back is what a new integration of the same inputs gives, bit for bit.  The effects gate of a
-/// family of models (ValidatedModelFamily) meets the same mode from the same start at many model
-/// points: a mode's z' = A z + c leaves out the effects it does not feel, so a candidate's range
-/// corners beside another base repeat most of its flows (≈ 80 % of the discrepancy workflow's
-/// reference integrations, bench/README.md "Speed at the limit").  Thread-safe; keeps the last
-/// `capacity` inputs (≈ 6 kB each at the gate's 120 times).
-class LinearReferenceCache {
+/// Appends the bytes of `n` doubles to `key` (−0 is not 0 there; a NaN is its own bits).
+void append_bits(std::string& key, const double* values, std::size_t n);
+
+/// Results of a deterministic computation kept by the exact bits of its inputs (`key`: what
+/// append_bits makes of them, with their sizes where they vary): the same inputs give the same
+/// bits, so what is handed back is what computing again would give.  Thread-safe; keeps the last
+/// `capacity` keys; computes outside its lock (two threads with one key both compute, to the
+/// same bits).  The gate's references use it: reference_contact_trajectory (per thread) and
+/// LinearReferenceCache.
+template <class Value>
+class KeptByBits {
  public:
-  explicit LinearReferenceCache(std::size_t capacity = 2048) : capacity_(capacity) {}
-  /// reference_linear_trajectory(segment, z0, times, tolerance), kept or integrated.
-  std::vector<SmallVector> trajectory(const LinearSegment& segment, const SmallVector& z0, const std::vector<double>& times,
-                                      double tolerance);
-  long hits() const;
-  long integrations() const;
+  explicit KeptByBits(std::size_t capacity) : capacity_(capacity) {}
+  /// The value kept under `key`, or compute()'s, then kept.
+  template <class Compute>
+  Value get(std::string key, const Compute& compute) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      const auto found = kept_.find(key);
+      if (found != kept_.end()) {
+        ++hits_;
+        return found->second;
+      }
+    }
+    Value value = compute();
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++computed_;
+    if (capacity_ > 0 && kept_.emplace(key, value).second) {
+      order_.push_back(std::move(key));
+      if (order_.size() > capacity_) {
+        kept_.erase(order_.front());
+        order_.pop_front();
+      }
+    }
+    return value;
+  }
+  long hits() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return hits_;
+  }
+  long computed() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return computed_;
+  }
 
  private:
   std::size_t capacity_;
   mutable std::mutex mutex_;
-  std::map<std::string, std::vector<SmallVector>> kept_;
+  std::map<std::string, Value> kept_;
   std::deque<std::string> order_;  ///< oldest first
-  long hits_ = 0, integrations_ = 0;
+  long hits_ = 0, computed_ = 0;
+};
+
+/// reference_linear_trajectory's results kept by their exact inputs — the bits of A, c, z0, the
+/// times and the tolerance (and their sizes).  The effects gate of a family of models
+/// (ValidatedModelFamily) meets the same mode from the same start at many model points: a mode's
+/// z' = A z + c leaves out the effects it does not feel, so a candidate's range corners beside
+/// another base repeat most of its flows (≈ 80 % of the discrepancy workflow's reference
+/// integrations, bench/README.md "Speed at the limit").  Keeps the last `capacity` inputs
+/// (≈ 6 kB each at the gate's 120 times).
+class LinearReferenceCache {
+ public:
+  explicit LinearReferenceCache(std::size_t capacity = 2048) : kept_(capacity) {}
+  /// reference_linear_trajectory(segment, z0, times, tolerance), kept or integrated.
+  std::vector<SmallVector> trajectory(const LinearSegment& segment, const SmallVector& z0, const std::vector<double>& times,
+                                      double tolerance);
+  long hits() const { return kept_.hits(); }
+  long integrations() const { return kept_.computed(); }
+
+ private:
+  KeptByBits<std::vector<SmallVector>> kept_;
 };
 
 }  // namespace backlash::numeric
