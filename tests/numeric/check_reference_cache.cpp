@@ -27,9 +27,9 @@ struct Input {
 Input random_input(std::mt19937_64& rng, int n) {
   std::uniform_real_distribution<double> u(-1, 1);
   Input in;
-  in.segment.A = SmallMatrix(n, n);
-  in.segment.c = SmallVector(n);
-  in.z0 = SmallVector(n);
+  in.segment.A = SmallMatrix::Zero(n, n);
+  in.segment.c = SmallVector::Zero(n);
+  in.z0 = SmallVector::Zero(n);
   for (int i = 0; i < n; ++i) {
     for (int j = 0; j < n; ++j) in.segment.A(i, j) = u(rng);
     in.segment.A(i, i) = -1.5 - std::fabs(u(rng)) * n;
@@ -117,6 +117,20 @@ TEST(LinearReferenceCache, an_input_pushed_out_is_integrated_again_to_the_same_b
   EXPECT_EQ(cache.integrations(), 4);
   EXPECT_TRUE(same_bits(kept(cache, c), fresh(c)));  // c still kept
   EXPECT_EQ(cache.hits(), 1);
+}
+
+// The input used last stays: a map's gate asks for the same few contact runs between new ones.
+TEST(LinearReferenceCache, the_input_used_least_recently_is_the_one_pushed_out) {
+  std::mt19937_64 rng(4);
+  LinearReferenceCache cache(2);
+  const Input a = random_input(rng, 2), b = random_input(rng, 3), c = random_input(rng, 4);
+  (void)kept(cache, a), (void)kept(cache, b), (void)kept(cache, a);  // a used after b
+  (void)kept(cache, c);                                              // b pushed out, not a
+  EXPECT_EQ(cache.integrations(), 3);
+  EXPECT_TRUE(same_bits(kept(cache, a), fresh(a)));
+  EXPECT_EQ(cache.integrations(), 3) << "a, used after b, was pushed out instead of b";
+  EXPECT_TRUE(same_bits(kept(cache, b), fresh(b)));
+  EXPECT_EQ(cache.integrations(), 4) << "b, used least recently, was still kept";
 }
 
 }  // namespace

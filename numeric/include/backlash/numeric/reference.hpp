@@ -15,8 +15,8 @@
 #include "backlash/numeric/segment_dynamics.hpp"
 
 #include <cstddef>
-#include <deque>
 #include <functional>
+#include <list>
 #include <map>
 #include <mutex>
 #include <string>
@@ -48,10 +48,10 @@ void append_bits(std::string& key, const double* values, std::size_t n);
 
 /// Results of a deterministic computation kept by the exact bits of its inputs (`key`: what
 /// append_bits makes of them, with their sizes where they vary): the same inputs give the same
-/// bits, so what is handed back is what computing again would give.  Thread-safe; keeps the last
-/// `capacity` keys; computes outside its lock (two threads with one key both compute, to the
-/// same bits).  The gate's references use it: reference_contact_trajectory (per thread) and
-/// LinearReferenceCache.
+/// bits, so what is handed back is what computing again would give.  Thread-safe; keeps the
+/// `capacity` keys used last; computes outside its lock (two threads with one key both compute,
+/// to the same bits).  The gate's references use it: reference_contact_trajectory (per thread)
+/// and LinearReferenceCache.
 template <class Value>
 class KeptByBits {
  public:
@@ -64,14 +64,17 @@ class KeptByBits {
       const auto found = kept_.find(key);
       if (found != kept_.end()) {
         ++hits_;
-        return found->second;
+        order_.splice(order_.end(), order_, found->second.place);  // used last
+        return found->second.value;
       }
     }
     Value value = compute();
     std::lock_guard<std::mutex> lock(mutex_);
     ++computed_;
-    if (capacity_ > 0 && kept_.emplace(key, value).second) {
-      order_.push_back(std::move(key));
+    if (capacity_ == 0) return value;
+    const auto [entry, added] = kept_.emplace(std::move(key), Entry{value, {}});
+    if (added) {
+      entry->second.place = order_.insert(order_.end(), entry);
       if (order_.size() > capacity_) {
         kept_.erase(order_.front());
         order_.pop_front();
@@ -89,10 +92,16 @@ class KeptByBits {
   }
 
  private:
+  struct Entry;
+  using Kept = std::map<std::string, Entry>;
+  struct Entry {
+    Value value;
+    typename std::list<typename Kept::iterator>::iterator place;  ///< in order_
+  };
   std::size_t capacity_;
   mutable std::mutex mutex_;
-  std::map<std::string, Value> kept_;
-  std::deque<std::string> order_;  ///< oldest first
+  Kept kept_;
+  std::list<typename Kept::iterator> order_;  ///< used first … used last
   long hits_ = 0, computed_ = 0;
 };
 
