@@ -32,24 +32,19 @@ void append_number(std::string& out, double value) {
 class ColumnTexts {
  public:
   void append(std::string& out, std::size_t column, double value) {
-    if (std::isnan(value)) return;
     if (column >= kept_.size()) kept_.resize(column + 1);
     Kept& k = kept_[column];
     std::uint64_t bits = 0;
     std::memcpy(&bits, &value, sizeof bits);
-    if (!k.valid || k.bits != bits) {
-      const auto result = std::to_chars(k.text, k.text + sizeof k.text, value);
-      k.length = static_cast<std::size_t>(result.ptr - k.text), k.bits = bits, k.valid = true;
-    }
-    out.append(k.text, k.length);
+    if (!k.valid || k.bits != bits) k.text.clear(), append_number(k.text, value), k.bits = bits, k.valid = true;
+    out += k.text;
   }
 
  private:
   struct Kept {
     std::uint64_t bits = 0;
     bool valid = false;
-    char text[32];
-    std::size_t length = 0;
+    std::string text;  ///< append_number's (short: within the small-string buffer)
   };
   std::vector<Kept> kept_;
 };
