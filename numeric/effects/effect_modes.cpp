@@ -119,6 +119,13 @@ bool well_conditioned_basis(const Eigen::MatrixXcd& vectors, const Eigen::Matrix
   return std::isfinite(condition) && condition <= limit;
 }
 
+// The product's real part is ac − bd unless that is NaN, when the product recovers infinities
+// (C99 Annex G, libgcc's __muldc3): then the product itself.
+double real_of_product(std::complex<double> a, std::complex<double> b) {
+  const double re = a.real() * b.real() - a.imag() * b.imag();
+  return std::isnan(re) ? (a * b).real() : re;
+}
+
 // z̃(τ) = e^{Mτ} z̃0 for the augmented M = [[A, c], [0, 0]]: by the eigen-decomposition of M when
 // it is diagonalisable with a well-conditioned basis (the generic mesh mode: two complex pairs
 // and the augmentation's 0), else by Eigen's Padé exponential at each τ.
@@ -221,11 +228,13 @@ struct ModeFlow::Generic {
           weights(j) = std::exp(lambda(j) * tau) * q(j);
         }
       }
+      // z_i = Re Σ_j V_ij w_j: only the real parts are summed, each Re(V_ij w_j) = ac − bd as the
+      // complex product forms it (the full product, with its recovery of infinities, where that is NaN).
       SmallVector z(n);
       for (int i = 0; i < n; ++i) {
-        std::complex<double> sum = 0;
-        for (int j = 0; j < m; ++j) sum += V(i, j) * weights(j);
-        z(i) = sum.real();
+        double sum = 0;
+        for (int j = 0; j < m; ++j) sum += real_of_product(V(i, j), weights(j));
+        z(i) = sum;
       }
       return z;
     }
@@ -352,15 +361,15 @@ ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const H
   const double J = p.Jm + p.JL, F = p.Fm + p.FL;
   const double T = e.coulomb_motor + e.coulomb_load;
   if (m.kind == ModeKind::Contact) {
-    if (m.slip_motor == 0) return;
-    if (m.regime == 0) {
+    if (m.slip_motor != 0 && m.regime == 0) {
       y_star_ = (drive_constant(e, 0) - T * m.slip_motor) / p.K;
       alpha_ = F / (2 * J);
       w2_ = p.K / J;
-    } else {
+    } else if (m.slip_motor != 0) {
       beta_ = F / J;
       g_ = segment_.c(1);
     }
+    theta_o_constant_ = theta_o_error().constant;
     return;
   }
   if (m.kind == ModeKind::Mesh) {
@@ -382,6 +391,7 @@ ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const H
     y_star_ = (drive_constant(e, 0) - e.coulomb_motor * m.slip_motor) / p.K;
     alpha_m_ = p.Fm / (2 * p.Jm);
     w2_m_ = p.K / p.Jm;
+    motor_y0_ = measured(p, start) - p.theta_R - y_star_;
   } else {
     motor_form_ = 3;  // driven by the moving load
     c0_ = segment_.c(1);
@@ -418,7 +428,8 @@ SmallVector ModeFlow::local(double tau) const {
       z << d0 * dp.c + (w0 + alpha_ * d0) * dp.s, w0 * dp.c - (alpha_ * w0 + w2_ * d0) * dp.s;
     } else {
       const double x = -beta_ * tau, w0 = z0_(1);
-      z << w0 * tau * phi(1, x) + g_ * tau * tau * phi(2, x), w0 * std::exp(x) + g_ * tau * phi(1, x);
+      const Phi12 f = phi12(x);
+      z << w0 * tau * f.phi1 + g_ * tau * tau * f.phi2, w0 * std::exp(x) + g_ * tau * f.phi1;
     }
     return z;
   }
@@ -443,7 +454,7 @@ SmallVector ModeFlow::local(double tau) const {
       z(1) = vm0 * k.exp_x + gm_ * tau * k.phi1_x;
       break;
     case 2: {
-      const double y0 = measured(p_, start_) - p_.theta_R - y_star_;
+      const double y0 = motor_y0_;
       const DampedPair dp = damped_pair(alpha_m_, w2_m_, tau);
       z(0) = y0 * (dp.c - 1) + (vm0 + alpha_m_ * y0) * dp.s;
       z(1) = vm0 * dp.c - (alpha_m_ * vm0 + w2_m_ * y0) * dp.s;
@@ -461,7 +472,7 @@ HybridState ModeFlow::state_of(const SmallVector& z) const {
   HybridState h;
   const Mode& m = mode_;
   if (m.kind == ModeKind::Contact) {
-    const double theta_o = p_.theta_R + theta_o_error().constant + z(0);
+    const double theta_o = p_.theta_R + theta_o_constant_ + z(0);
     h = state_on_face(p_, m.face, theta_o, z(1), true);
     h.motor_stuck = h.load_stuck = m.slip_motor == 0;
   } else {

@@ -43,6 +43,7 @@
 #include "backlash/numeric/mode.hpp"
 #include "backlash/numeric/segment_dynamics.hpp"
 
+#include <complex>
 #include <functional>
 #include <memory>
 #include <string>
@@ -80,6 +81,10 @@ ModeSystem mode_system(const Parameters& p, const Effects& e, const Mode& m, con
 /// of the moduli |v_ij| as Eigen's cwiseAbs forms them — decided without the moduli where bounds
 /// on them decide it (the mesh modes' flow uses its eigen-decomposition only then).
 bool well_conditioned_basis(const Eigen::MatrixXcd& vectors, const Eigen::MatrixXcd& inverse, double limit);
+
+/// Re(a·b) with the bits of (a * b).real() and without the imaginary part (the mesh flow's
+/// sums Re Σ_j V_ij w_j: only real parts are read).
+double real_of_product(std::complex<double> a, std::complex<double> b);
 
 /// A mode's closed-form motion from a state.
 class ModeFlow {
@@ -135,6 +140,8 @@ class ModeFlow {
   // closed-form constants
   double alpha_ = 0, w2_ = 0, beta_ = 0, g_ = 0;  // contact
   double y_star_ = 0;                              // contact / motor: equilibrium shift
+  double theta_o_constant_ = 0;  // contact: theta_o_error().constant, formed once (state_of's, per sample)
+  double motor_y0_ = 0;          // closed loop at the motor: θo0 − θR − y*, formed once (local's, per sample)
   double a_ = 0, b_ = 0, k_ = 0, c0_ = 0, gL_ = 0, gm_ = 0, alpha_m_ = 0, w2_m_ = 0;  // free
   int motor_form_ = 0;  // 0 stuck, 1 constant drive, 2 closed loop at the motor, 3 driven by the load
   std::shared_ptr<const Generic> generic_;

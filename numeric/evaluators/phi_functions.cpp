@@ -49,6 +49,16 @@ double phi(int n, double x) {
   return value;
 }
 
+Phi12 phi12(double x) {
+  const double ax = std::fabs(x);
+  if (ax < 1.0) {
+    const int terms = series_terms(ax);
+    return {phi_series(1, x, terms), phi_series(2, x, terms)};
+  }
+  const double phi1 = std::expm1(x) / x;
+  return {phi1, (phi1 - inverse_factorial[1]) / x};
+}
+
 double exp_divided_difference(int n, double x, double y) {
   if (n < 0 || n > 3) throw std::invalid_argument("exp_divided_difference: n must be 0..3");
   const double ax = std::fabs(x), ay = std::fabs(y);

@@ -42,6 +42,13 @@ namespace backlash::numeric {
 /// φ_n(x) = Σ_{j≥0} x^j/(j+n)!, n = 0…4 (accurate to a few ulps for x ≤ 0 and moderate x > 0).
 double phi(int n, double x);
 
+/// φ1(x) and φ2(x), phi(1, x) and phi(2, x) bit for bit, with one expm1 for |x| ≥ 1 (phi(2, x)
+/// forms φ1 on its way: φ2 = (φ1 − 1)/x) and one choice of series length below.
+struct Phi12 {
+  double phi1, phi2;
+};
+Phi12 phi12(double x);
+
 /// exp[0^n, x, y]: the divided difference of exp over n zeros and x, y; n = 0…3.
 double exp_divided_difference(int n, double x, double y);
 

@@ -16,7 +16,11 @@
 //                                 answers as the test on the moduli themselves, on random bases with
 //                                 the limit placed at, just around and far from their condition;
 //   check_mesh_bound_holds        the mesh modes' bound on |w'''| over [a, b] (a conjugate pair's
-//                                 exponential formed once) is not below |eᵀA²(A z + c)| anywhere on it.
+//                                 exponential formed once) is not below |eᵀA²(A z + c)| anywhere on it;
+//   check_sampling_as_before      the sampling's shortcuts give the bits of what they replace (issue 19):
+//                                 phi12 is phi(1, ·), phi(2, ·); real_of_product is (a * b).real(),
+//                                 with infinities, NaNs and overflow among the operands; a contact
+//                                 state is placed at θR + theta_o_error().constant + z(0).
 #include "effects/effect_modes.hpp"
 #include "effects/effects_engine.hpp"
 #include "evaluators/phi_functions.hpp"
@@ -31,6 +35,7 @@
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include <cmath>
+#include <complex>
 #include <cstring>
 #include <random>
 #include <string>
@@ -192,4 +197,58 @@ TEST(EffectsEngineSearches, check_mesh_bound_holds) {
     }
   });
   EXPECT_GT(checked, 0);
+}
+
+TEST(EffectsEngineSearches, check_sampling_as_before) {
+  std::mt19937 random(1907);
+  std::uniform_real_distribution<double> exponent(-8, 3), unit(-1, 1);
+  for (int trial = 0; trial < 20000; ++trial) {
+    double x = (unit(random) > 0 ? 1 : -1) * std::pow(10.0, exponent(random));
+    if (trial % 50 == 0) x = std::nextafter(trial % 100 == 0 ? 1.0 : -1.0, unit(random) > 0 ? 2.0 : -2.0);
+    const numeric::Phi12 f = numeric::phi12(x);
+    EXPECT_TRUE(same_bits(f.phi1, numeric::phi(1, x)) && same_bits(f.phi2, numeric::phi(2, x))) << x;
+  }
+  const double specials[] = {0.0, -0.0, 1.0, -2.5, 1e300, -1e300, 1e-300, INFINITY, -INFINITY, NAN};
+  std::uniform_int_distribution<int> pick(0, 2 * static_cast<int>(std::size(specials)) - 1);
+  const auto entry = [&] {
+    const int k = pick(random);
+    return k < static_cast<int>(std::size(specials)) ? specials[k] : unit(random) * std::pow(10.0, 4 * exponent(random));
+  };
+  int recovered = 0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    const std::complex<double> a(entry(), entry()), b(entry(), entry());
+    const double expected = (a * b).real(), got = numeric::real_of_product(a, b);
+    const double naive = a.real() * b.real() - a.imag() * b.imag();
+    if (std::isnan(naive) && !std::isnan(expected)) ++recovered;
+    EXPECT_TRUE(same_bits(got, expected) || (std::isnan(got) && std::isnan(expected)))
+        << a << " * " << b << ": " << got << " against " << expected;
+  }
+  EXPECT_GT(recovered, 0) << "no operands where the product recovers an infinity: the fallback is untested";
+  // Contact states: θo placed from the mode's functional.
+  const numeric::Parameters p = numeric::parameters_of(model::load_case("V"));
+  numeric::Effects e;
+  e.coulomb_motor = 0.01;
+  e.coulomb_load = 0.02;
+  e.saturation = 0.8;
+  e.torque_offset = 0.05;
+  int contacts = 0;
+  for (const numeric::Mode& m : numeric::reachable_modes(p, e)) {
+    if (m.kind != numeric::ModeKind::Contact) continue;
+    for (int trial = 0; trial < 5; ++trial) {
+      const numeric::HybridState start =
+          numeric::state_on_face(p, m.face, 0.6 + 0.3 * unit(random), m.slip_motor * std::fabs(unit(random)), true);
+      const numeric::ModeFlow flow(p, e, m, start);
+      for (double tau : {0.0, 0.01, 0.7, 3.0}) {
+        const numeric::SmallVector z = flow.local(tau);
+        const numeric::HybridState h = flow.state(tau);
+        const numeric::HybridState expected =
+            numeric::state_on_face(p, m.face, p.theta_R + flow.theta_o_error().constant + z(0), z(1), true);
+        EXPECT_TRUE(same_bits(h.theta_m, expected.theta_m) && same_bits(h.theta_L, expected.theta_L) &&
+                    same_bits(h.dtheta_m, expected.dtheta_m) && same_bits(h.dtheta_L, expected.dtheta_L))
+            << m.describe() << ", tau " << tau;
+        ++contacts;
+      }
+    }
+  }
+  EXPECT_GT(contacts, 0);
 }
