@@ -54,9 +54,22 @@ constexpr std::size_t kKeptSimulations = 256;
 
 std::shared_ptr<const Simulator::Kept> Simulator::recall(const std::string& key) {
   std::lock_guard<std::mutex> lock(cache_mutex_);
-  const auto found = cache_.find(key);
-  if (found == cache_.end()) return nullptr;
-  return found->second;
+  if (const auto found = cache_.find(key); found != cache_.end()) return found->second;
+  const auto held = held_.find(key);
+  return held == held_.end() ? nullptr : held->second.lock();
+}
+
+Simulator::Held Simulator::hold(const ModelPoint& m, std::size_t samples, Grid grid) {
+  samples = std::min(samples, data_.size());
+  if (rows(samples, grid).size() == samples) grid = Grid::all;  // as traces() keeps it
+  std::lock_guard<std::mutex> lock(cache_mutex_);
+  std::erase_if(held_, [](const auto& entry) { return entry.second.expired(); });
+  for (const std::string& key : {key_of(m, samples, Grid::all), key_of(m, samples, grid)})
+    if (const auto found = cache_.find(key); found != cache_.end()) {
+      held_[key] = found->second;
+      return found->second;
+    }
+  return nullptr;
 }
 
 void Simulator::keep(const std::string& key, std::shared_ptr<const Kept> kept) {

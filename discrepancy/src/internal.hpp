@@ -91,6 +91,16 @@ class Simulator {
   /// simulation kept on the whole grid serves it too.
   Traces traces(const ModelPoint& m, std::size_t samples, std::vector<numeric::SimulationEvent>* events = nullptr,
                 long* cost = nullptr, Grid grid = Grid::all);
+  /// A kept simulation (of `m` at this length, on this grid or the whole one) held past the last
+  /// 256 kept for as long as the handle lives: a screened partner's best point, where its pair's
+  /// fit starts once every other partner has been screened.  Empty if none is kept.
+  using Held = std::shared_ptr<const void>;
+  Held hold(const ModelPoint& m, std::size_t samples, Grid grid);
+  /// `n` simulations served from what the search already knows (a screen done before), their
+  /// `work` charged as kept ones are: the count and the budget as if they had been asked for.
+  void charge(int n, long work) { simulations_ += n, hits_ += n, work_ += work; }
+  /// Whether `work` more keeps the search below its budget (budget_reached() stays false throughout).
+  bool affords(long work) const { return work_.load() + work < budget_; }
   /// Validates the family at these model points (a candidate's range corners).
   void prepare(const std::vector<ModelPoint>& points);
   int simulations() const { return simulations_.load(); }
@@ -123,6 +133,7 @@ class Simulator {
   std::mutex cache_mutex_;
   std::map<std::string, std::shared_ptr<const Kept>> cache_;  ///< the last simulations, by model point and length
   std::vector<std::string> cache_order_;                    ///< oldest first
+  std::map<std::string, std::weak_ptr<const Kept>> held_;   ///< hold()'s, while their handles live
   std::atomic<int> hits_{0};
   const Observations& data_;
   double step_, t_end_, step_time_;

@@ -185,10 +185,21 @@ void parallel_for(std::size_t n, int threads, Job job) {
   for (std::thread& th : pool) th.join();
 }
 
+// What a computation asked of the simulator: its simulations and their work (Simulator::traces's
+// cost).  Exact when every one had a cost: a point outside the family or one that threw has none
+// (not kept: asked again, it is tried again, not served).
+struct Charged {
+  int simulations = 0;
+  long work = 0;
+  bool exact = true;
+  void add(long cost) { ++simulations, work += cost, exact = exact && cost > 0; }
+};
+
 // The directions in which already-fitted parameters move the residual on the fitted samples: the
 // columns ∂r/∂u at `u` of `c` applied to `base` (central differences, ±0.01 in u), orthonormalised
-// (thin QR).  Empty when a point could not be simulated.
-Eigen::MatrixXd directions(Search& s, const EffectCandidate& c, const ModelPoint& base, const std::vector<double>& u) {
+// (thin QR).  Empty when a point could not be simulated.  `charged`, if given, adds its simulations.
+Eigen::MatrixXd directions(Search& s, const EffectCandidate& c, const ModelPoint& base, const std::vector<double>& u,
+                           Charged* charged = nullptr) {
   const std::size_t n = s.o.fit_indices.size() * s.o.columns.size();
   Eigen::MatrixXd jacobian(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(u.size()));
   for (std::size_t k = 0; k < u.size(); ++k) {
@@ -198,7 +209,9 @@ Eigen::MatrixXd directions(Search& s, const EffectCandidate& c, const ModelPoint
     for (const std::vector<double>* at : {&plus, &minus}) {
       std::vector<double> values;
       for (std::size_t i = 0; i < at->size(); ++i) values.push_back(c.ranges[i].value((*at)[i]));
-      const auto traces = s.simulator.traces(c.apply(base, values), s.o.size(), nullptr, nullptr, Simulator::Grid::fitted);
+      long cost = 0;
+      const auto traces = s.simulator.traces(c.apply(base, values), s.o.size(), nullptr, &cost, Simulator::Grid::fitted);
+      if (charged) charged->add(cost);
       if (!traces) return {};
       r.push_back(residuals(s.o, *traces, s.o.fit_indices));
     }
@@ -220,23 +233,26 @@ std::pair<EffectCandidate, std::vector<double>> named_joint(const Search& s) {
 }
 
 // The directions of everything named, and of `also` at `also_u` if given (none: empty).
-Eigen::MatrixXd named_directions(Search& s, const EffectCandidate* also = nullptr, const std::vector<double>* also_u = nullptr) {
+Eigen::MatrixXd named_directions(Search& s, const EffectCandidate* also = nullptr, const std::vector<double>* also_u = nullptr,
+                                 Charged* charged = nullptr) {
   auto [joint, u] = named_joint(s);
   if (!also) return u.empty() ? Eigen::MatrixXd() : directions(s, joint, s.base, u);
   std::vector<EffectCandidate> parts;
   if (!u.empty()) parts.push_back(joint);
   parts.push_back(*also);
   u.insert(u.end(), also_u->begin(), also_u->end());
-  return directions(s, combined(parts), s.base, u);
+  return directions(s, combined(parts), s.base, u, charged);
 }
 
 // The best point of a candidate's scan added to `at`, on the fitted samples: its sum of squares
 // with the `fitted` directions projected out — what is left once the parameters already fitted
 // move with it, to first order (a partner that only shows when they move ranks where it belongs)
 // — INFINITY if no point could be simulated, and u.  At most a quarter of a single candidate's
-// budget (a stiff mesh with a delay is slow).
+// budget (a stiff mesh with a delay is slow).  `held`, if given, holds the best point's simulation
+// (Simulator::hold: a pair's fit starts there, after thousands of other simulations); `charged`,
+// if given, adds the scan's simulations.
 double best_scan_point(Search& s, const EffectCandidate& c, const ModelPoint& at, const Eigen::MatrixXd& fitted,
-                       std::vector<double>& best_u) {
+                       std::vector<double>& best_u, Simulator::Held* held = nullptr, Charged* charged = nullptr) {
   double best = INFINITY;
   long work = 0;
   prepare_candidate(s.simulator, c, at);  // else every scan point outside the box is validated alone
@@ -245,14 +261,19 @@ double best_scan_point(Search& s, const EffectCandidate& c, const ModelPoint& at
     std::vector<double> values;
     for (std::size_t k = 0; k < u.size(); ++k) values.push_back(c.ranges[k].value(u[k]));
     long cost = 0;
-    const auto traces = s.simulator.traces(c.apply(at, values), s.o.size(), nullptr, &cost, Simulator::Grid::fitted);
+    const ModelPoint point = c.apply(at, values);
+    const auto traces = s.simulator.traces(point, s.o.size(), nullptr, &cost, Simulator::Grid::fitted);
     work += cost;
+    if (charged) charged->add(cost);
     if (!traces) continue;
     std::vector<double> r = residuals(s.o, *traces, s.o.fit_indices);
     double sse = sum_of_squares(r);
     if (fitted.cols() > 0 && static_cast<std::size_t>(fitted.rows()) == r.size())
       sse -= (fitted.transpose() * Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<Eigen::Index>(r.size()))).squaredNorm();
-    if (sse < best) best = sse, best_u = u;
+    if (sse < best) {
+      best = sse, best_u = u;
+      if (held) *held = s.simulator.hold(point, s.o.size(), Simulator::Grid::fitted);
+    }
   }
   return best;
 }
@@ -360,12 +381,28 @@ struct Screened {
   std::vector<double> u;  ///< the partner's best scan point
   double sse = INFINITY;
   std::string problem;    ///< why the two cannot be combined
+  Simulator::Held held;   ///< the best point's simulation, kept for the pair's fit (it starts there)
+  Charged charged;        ///< the simulations of the single's directions and of this scan
 };
 
 // The partner's scan, every point on the fitted samples with `single` at its fit.
 void screen(Screened& x, Search& s, const Eigen::MatrixXd& single) {
   x.problem = combination_problem(x.single->result.effect, x.partner->result.effect);
-  if (x.problem.empty()) x.sse = best_scan_point(s, x.partner->candidate, x.single->point, single, x.u);
+  if (x.problem.empty()) x.sse = best_scan_point(s, x.partner->candidate, x.single->point, single, x.u, &x.held, &x.charged);
+}
+
+// A screen already done (`screened`: the same single and partner) taken over for `x`: what
+// screening it again gives, bit for bit — the single's directions and the partner's scan are the
+// same simulations, served as kept ones and charged again — provided none is outside the family
+// and the search's budget cannot end them on the way (docs/discrepancy.md, "Work budget").  False
+// (nothing done) otherwise.
+bool take_over(Screened& x, Search& s, const std::vector<Screened>& screened) {
+  const auto y = std::find_if(screened.begin(), screened.end(),
+                              [&](const Screened& y) { return y.single == x.single && y.partner == x.partner; });
+  if (y == screened.end() || !y->problem.empty() || !y->charged.exact || !s.simulator.affords(y->charged.work)) return false;
+  x.problem = y->problem, x.u = y->u, x.sse = y->sse, x.held = y->held, x.charged = y->charged;
+  s.simulator.charge(y->charged.simulations, y->charged.work);
+  return true;
 }
 
 // An effect paired with a nominal parameter's correction, chosen from one side only (the other
@@ -373,18 +410,20 @@ void screen(Screened& x, Search& s, const Eigen::MatrixXd& single) {
 // single screened at it.  A parameter error that a wrong effect's fit absorbs in part shows little
 // alone (a 15 % error in motor.J: ΔBIC −87 beside a Coulomb friction's −1162), and the pair fitted
 // from the effect's biased fit ends in a wrong valley (ΔBIC −1260, at a range's edge) where the
-// parameter's side reaches the noise (−22636).  `reversed` holds the new starts (stable addresses).
-void add_reverse_starts(Search& s, std::vector<std::vector<const Screened*>>& chosen, std::deque<Screened>& reversed) {
+// parameter's side reaches the noise (−22636).  `reversed` holds the new starts (stable addresses);
+// a start whose partner is a base was screened already (in `screened`: take_over).
+void add_reverse_starts(Search& s, std::vector<std::vector<const Screened*>>& chosen, const std::vector<Screened>& screened,
+                        std::deque<Screened>& reversed) {
   std::vector<std::size_t> which;
   for (std::size_t i = 0; i < chosen.size(); ++i) {
     const Screened& x = *chosen[i].front();
     if (chosen[i].size() == 1 &&
         is_parameter_correction(x.single->result.effect) != is_parameter_correction(x.partner->result.effect))
-      reversed.push_back({x.partner, x.single, {}, INFINITY, ""}), which.push_back(i);
+      reversed.push_back({x.partner, x.single, {}, INFINITY, "", nullptr, {}}), which.push_back(i);
   }
   parallel_for(reversed.size(), s.options.threads, [&](std::size_t i) {
     Screened& x = reversed[i];
-    screen(x, s, named_directions(s, &x.single->candidate, &x.single->fit.u));
+    if (!take_over(x, s, screened)) screen(x, s, named_directions(s, &x.single->candidate, &x.single->fit.u, &x.charged));
   });
   for (std::size_t i = 0; i < reversed.size(); ++i)
     if (std::isfinite(reversed[i].sse)) chosen[which[i]].push_back(&reversed[i]);
@@ -397,14 +436,16 @@ void screen_partners(Search& s, const std::vector<const Trial*>& fitted, std::si
   const std::size_t first = screened.size();
   for (std::size_t i = from; i < to; ++i)
     for (const Trial* partner : fitted)
-      if (partner != fitted[i]) screened.push_back({fitted[i], partner, {}, INFINITY, ""});
+      if (partner != fitted[i]) screened.push_back({fitted[i], partner, {}, INFINITY, "", nullptr, {}});
   std::vector<Eigen::MatrixXd> moving(to - from);  // each S's directions (with the named)
+  std::vector<Charged> charged(to - from);         // and their simulations
   parallel_for(moving.size(), s.options.threads, [&](std::size_t i) {
-    moving[i] = named_directions(s, &fitted[from + i]->candidate, &fitted[from + i]->fit.u);
+    moving[i] = named_directions(s, &fitted[from + i]->candidate, &fitted[from + i]->fit.u, &charged[i]);
   });
   parallel_for(screened.size() - first, s.options.threads, [&](std::size_t i) {
     Screened& x = screened[first + i];
     const std::size_t which = static_cast<std::size_t>(std::find(fitted.begin(), fitted.end(), x.single) - fitted.begin());
+    x.charged = charged[which - from];
     screen(x, s, moving[which - from]);
   });
 }
@@ -495,7 +536,7 @@ std::optional<Trial> best_pair(Search& s, const std::vector<Trial>& singles, dou
       round.push_back(refused);
     }
   std::deque<Screened> reversed;
-  add_reverse_starts(s, chosen, reversed);
+  add_reverse_starts(s, chosen, screened, reversed);
   std::vector<Trial> pairs(chosen.size());
   parallel_for(chosen.size(), s.options.threads, [&](std::size_t i) {
     for (const Screened* from : chosen[i]) {

@@ -7,7 +7,10 @@
 //   item_a_whole_grid_simulation_serves_a_fit  a point simulated on the whole grid is not
 //           simulated again for a fit (kept), its work counted again (the budget is a count);
 //   item_a_fit_prefix_samples_its_rows  a fit's shorter horizon: the fitted rows below it and its
-//           last row, nothing after it.
+//           last row, nothing after it;
+//   item_a_held_simulation_outlives_the_kept_ones  a simulation held (a screened partner's best
+//           point, where its pair's fit starts) serves its point after 300 others have pushed it out
+//           of the 256 kept, with the same bits and its work counted again — and, released, no longer.
 // On main the simulator computed every sample of every simulation (no Grid): this file does not
 // build there.
 #include "../../discrepancy/src/internal.hpp"
@@ -129,6 +132,37 @@ TEST(DiscrepancyReuse, item_a_fit_prefix_samples_its_rows) {
   (void)shared.traces(m, 30);
   (void)shared.traces(m, 30, nullptr, nullptr, Simulator::Grid::fitted);
   EXPECT_EQ(shared.cache_hits(), 1);
+}
+
+TEST(DiscrepancyReuse, item_a_held_simulation_outlives_the_kept_ones) {
+  const Observations o = record();
+  const ModelPoint m = points()[1];
+  Simulator simulator(o, kStep, o.t.back());
+  const auto first = simulator.traces(m, o.size(), nullptr, nullptr, Simulator::Grid::fitted);
+  ASSERT_TRUE(first);
+  Simulator::Held held = simulator.hold(m, o.size(), Simulator::Grid::fitted);
+  EXPECT_TRUE(held);
+  EXPECT_FALSE(simulator.hold(points()[2], o.size(), Simulator::Grid::fitted));  // never simulated: nothing to hold
+  auto push_out = [&](int from) {  // 300 other model points, 20 samples each: more than the 256 kept
+    for (int k = from; k < from + 300; ++k) {
+      ModelPoint other = m;
+      other.e.coulomb_load *= 1 + 1e-3 * (k + 1);
+      (void)simulator.traces(other, 20, nullptr, nullptr, Simulator::Grid::fitted);
+    }
+  };
+  push_out(0);
+  const long work = simulator.work(), samples = simulator.samples_computed();
+  const int hits = simulator.cache_hits();
+  const auto again = simulator.traces(m, o.size(), nullptr, nullptr, Simulator::Grid::fitted);
+  ASSERT_TRUE(again);
+  EXPECT_EQ(simulator.cache_hits(), hits + 1);
+  EXPECT_EQ(simulator.samples_computed(), samples);
+  EXPECT_GT(simulator.work(), work);  // charged again: the budget does not depend on what was kept
+  for (std::size_t i : o.fit_indices) EXPECT_TRUE(same_bits((*again)[0][i], (*first)[0][i])) << "row " << i;
+  held.reset();  // released: pushed out like any other
+  push_out(300);
+  (void)simulator.traces(m, o.size(), nullptr, nullptr, Simulator::Grid::fitted);
+  EXPECT_EQ(simulator.samples_computed(), samples + 300 * 20 + static_cast<long>(o.fit_indices.size()));
 }
 
 }  // namespace
