@@ -147,6 +147,7 @@ Simulator::Traces Simulator::simulate(const ModelPoint& m, std::size_t samples, 
     ++filled;
   };
   o.sample_sink = keep;
+  o.sample_theta_o_only = std::all_of(data_.which.begin(), data_.which.end(), [](int c) { return c == 0; });  // θo alone read
   ++simulations_;
   samples_ += static_cast<long>(rows.size());
   numeric::SimulationResult r;

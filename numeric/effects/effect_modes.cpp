@@ -403,16 +403,58 @@ ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const H
 // bits: coupled_kernels forms e^x, φ1, φ2 of each node by phi_pair; the rest stay 0).
 CoupledKernels ModeFlow::free_kernels(double x, double y) const {
   if (motor_form_ == 3) return coupled_kernels(x, y);
+  return node_kernels(x, y, true, true);
+}
+
+// The kernels of the nodes asked for (the motor's x when its drive is constant, the load's y when
+// it slips), each by phi_pair as coupled_kernels forms it; the rest 0.
+CoupledKernels ModeFlow::node_kernels(double x, double y, bool motor, bool load) const {
   CoupledKernels k{0, 0, 0, 0, 0, 0, 0, 0, 0};
-  if (motor_form_ == 1) {
+  if (motor && motor_form_ == 1) {
     const PhiPair px = phi_pair(x);
     k.exp_x = px.e, k.phi1_x = px.phi1, k.phi2_x = px.phi2;
   }
-  if (mode_.slip_load != 0) {
+  if (load && mode_.slip_load != 0) {
     const PhiPair py = phi_pair(y);
     k.exp_y = py.e, k.phi1_y = py.phi1, k.phi2_y = py.phi2;
   }
   return k;
+}
+
+void ModeFlow::load_part(double tau, const CoupledKernels& k, double& z2, double& z3) const {
+  const double vL0 = z0_(3), t2 = tau * tau;
+  if (mode_.slip_load == 0) {
+    z2 = 0;
+    z3 = 0;
+  } else {
+    z2 = vL0 * tau * k.phi1_y + gL_ * t2 * k.phi2_y;
+    z3 = vL0 * k.exp_y + gL_ * tau * k.phi1_y;
+  }
+}
+
+void ModeFlow::motor_part(double tau, const CoupledKernels& k, double& z0, double& z1) const {
+  const double vm0 = z0_(1), vL0 = z0_(3), t2 = tau * tau;
+  switch (motor_form_) {
+    case 0:
+      z0 = 0;
+      z1 = 0;
+      break;
+    case 1:
+      z0 = vm0 * tau * k.phi1_x + gm_ * t2 * k.phi2_x;
+      z1 = vm0 * k.exp_x + gm_ * tau * k.phi1_x;
+      break;
+    case 2: {
+      const double y0 = motor_y0_;
+      const DampedPair dp = damped_pair(alpha_m_, w2_m_, tau);
+      z0 = y0 * (dp.c - 1) + (vm0 + alpha_m_ * y0) * dp.s;
+      z1 = vm0 * dp.c - (alpha_m_ * vm0 + w2_m_ * y0) * dp.s;
+      break;
+    }
+    default:
+      z0 = vm0 * tau * k.phi1_x + c0_ * t2 * k.phi2_x - k_ * vL0 * t2 * tau * k.a2 - k_ * gL_ * t2 * t2 * k.a3;
+      z1 = vm0 * k.exp_x + c0_ * tau * k.phi1_x - k_ * vL0 * t2 * k.a1 - k_ * gL_ * t2 * tau * k.a2;
+      break;
+  }
 }
 
 SmallVector ModeFlow::local(double tau) const {
@@ -434,38 +476,27 @@ SmallVector ModeFlow::local(double tau) const {
     return z;
   }
   SmallVector z(4);
-  const double vm0 = z0_(1), vL0 = z0_(3);
-  const double y = -b_ * tau, x = -a_ * tau, t2 = tau * tau;
-  const CoupledKernels k = free_kernels(x, y);
-  if (m.slip_load == 0) {
-    z(2) = 0;
-    z(3) = 0;
-  } else {
-    z(2) = vL0 * tau * k.phi1_y + gL_ * t2 * k.phi2_y;
-    z(3) = vL0 * k.exp_y + gL_ * tau * k.phi1_y;
-  }
-  switch (motor_form_) {
-    case 0:
-      z(0) = 0;
-      z(1) = 0;
-      break;
-    case 1:
-      z(0) = vm0 * tau * k.phi1_x + gm_ * t2 * k.phi2_x;
-      z(1) = vm0 * k.exp_x + gm_ * tau * k.phi1_x;
-      break;
-    case 2: {
-      const double y0 = motor_y0_;
-      const DampedPair dp = damped_pair(alpha_m_, w2_m_, tau);
-      z(0) = y0 * (dp.c - 1) + (vm0 + alpha_m_ * y0) * dp.s;
-      z(1) = vm0 * dp.c - (alpha_m_ * vm0 + w2_m_ * y0) * dp.s;
-      break;
-    }
-    default:
-      z(0) = vm0 * tau * k.phi1_x + c0_ * t2 * k.phi2_x - k_ * vL0 * t2 * tau * k.a2 - k_ * gL_ * t2 * t2 * k.a3;
-      z(1) = vm0 * k.exp_x + c0_ * tau * k.phi1_x - k_ * vL0 * t2 * k.a1 - k_ * gL_ * t2 * tau * k.a2;
-      break;
-  }
+  const CoupledKernels k = free_kernels(-a_ * tau, -b_ * tau);
+  load_part(tau, k, z(2), z(3));
+  motor_part(tau, k, z(0), z(1));
   return z;
+}
+
+// A contact's θo is state_of's θR + constant + z(0); a free flight's the measured shaft's start
+// plus its own local coordinate, from the kernels of its node alone (the load's are the same bits
+// whether coupled_kernels or phi_pair forms them; a motor driven by the moving load needs all).
+double ModeFlow::measured_at(double tau) const {
+  const Mode& m = mode_;
+  if (generic_) return measured(p_, state(tau));
+  if (m.kind == ModeKind::Contact) return p_.theta_R + theta_o_constant_ + local(tau)(0);
+  double position = 0, rate = 0;
+  if (p_.measured_at == model::MeasuredAt::Motor) {
+    if (motor_form_ == 3) return start_.theta_m + local(tau)(0);
+    motor_part(tau, node_kernels(-a_ * tau, -b_ * tau, true, false), position, rate);
+    return start_.theta_m + position;
+  }
+  load_part(tau, node_kernels(-a_ * tau, -b_ * tau, false, true), position, rate);
+  return start_.theta_L + position;
 }
 
 HybridState ModeFlow::state_of(const SmallVector& z) const {

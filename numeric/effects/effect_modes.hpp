@@ -103,6 +103,9 @@ class ModeFlow {
   const SmallVector& forcing_magnitude() const { return c_magnitude_; }
   /// The full state at τ (flags of the mode: in_contact, face, stuck, regime).
   HybridState state(double tau) const;
+  /// The measured shaft's angle θo at τ, rad: measured(p, state(τ)) bit for bit, with only the
+  /// terms θo reads formed (a free flight's other shaft's kernels are not computed).
+  double measured_at(double tau) const;
   /// The full state for local coordinates z.
   HybridState state_of(const SmallVector& z) const;
   /// The gap x = θL − θm for local coordinates z, and the measured shaft.
@@ -131,6 +134,10 @@ class ModeFlow {
   struct Generic;
   std::function<double(double, double)> matrix_exponential_bound(const SmallRow& row, int order) const;
   CoupledKernels free_kernels(double x, double y) const;
+  CoupledKernels node_kernels(double x, double y, bool motor, bool load) const;
+  // A free flight's local coordinates from its kernels: the motor's (z0, z1), the load's (z2, z3).
+  void motor_part(double tau, const CoupledKernels& k, double& z0, double& z1) const;
+  void load_part(double tau, const CoupledKernels& k, double& z2, double& z3) const;
   Parameters p_;
   Effects e_;
   Mode mode_;

@@ -476,35 +476,43 @@ SimulationResult Engine::advance() {
     const Mode mode = mode_of(state_);
     const double remaining = o_.t_end - t_;
     const std::unique_ptr<Segment> segment = next_segment(mode, remaining);
+    const auto record = [this, &segment](double from, double upto) {  // the samples over [from, upto]
+      if (o_.sample_theta_o_only)
+        recorder_.record(from, upto, [this, &segment](double tau) { return segment->measured_at(p_, tau); });
+      else
+        recorder_.record(from, upto, [&segment](double tau) { return segment->state(tau); });
+    };
     if (segment->rest) {  // everything stuck, the drive constant (or coasting to rest): nothing can change any more
       if (segment->rest_after > 0) {
-        recorder_.record(t_, t_ + segment->rest_after, [&segment](double tau) { return segment->state(tau); });
+        record(t_, t_ + segment->rest_after);
         state_ = segment->state(segment->rest_after);
         t_ += segment->rest_after;
       }
       push(EventKind::Rest);
       const HybridState resting = state_;
-      recorder_.record(t_, o_.t_end + 1e-12, [&resting](double) { return resting; });
+      if (o_.sample_theta_o_only)
+        recorder_.record(t_, o_.t_end + 1e-12, [theta_o = measured(p_, resting)](double) { return theta_o; });
+      else
+        recorder_.record(t_, o_.t_end + 1e-12, [&resting](double) { return resting; });
       t_ = o_.t_end;
       return finish(SimulationStatus::Rest);
     }
     if (o_.track_extremes && t_ >= engine_.extremes_after) segment->extremes(segment->duration, result_.extremes);
     const double t0 = t_;
-    auto at = [&segment](double tau) { return segment->state(tau); };
     if (!segment->exit) {
       if (segment->duration < remaining) {  // a breakpoint of the delayed model: the mode goes on
-        recorder_.record(t0, t0 + segment->duration, at);
+        record(t0, t0 + segment->duration);
         state_ = segment->state(segment->duration);
         t_ = t0 + segment->duration;
         continue;
       }
-      recorder_.record(t0, o_.t_end + 1e-12, at);
+      record(t0, o_.t_end + 1e-12);
       if (rests_in_free_flight(mode, *segment, remaining)) return finish(SimulationStatus::Rest);
       state_ = segment->state(remaining);
       t_ = o_.t_end;
       return finish(SimulationStatus::Completed);
     }
-    recorder_.record(t0, t0 + segment->exit->tau + 1e-12, at);
+    record(t0, t0 + segment->exit->tau + 1e-12);
     state_ = segment->state(segment->exit->tau);
     t_ = t0 + segment->exit->tau;
     const std::size_t events = result_.events.size();

@@ -95,6 +95,8 @@ class Segment {
  public:
   virtual ~Segment() = default;
   virtual HybridState state(double tau) const = 0;
+  /// θo at τ, measured(p, state(τ)) bit for bit (a segment may form fewer terms for it).
+  virtual double measured_at(const Parameters& p, double tau) const { return measured(p, state(tau)); }
   /// Adds the extremes of θo, θm, θL over [0, duration] (ends and velocity zeros).
   virtual void extremes(double duration, Extremes& x) const = 0;
   std::optional<Exit> exit;  ///< the first exit before the horizon

@@ -377,6 +377,7 @@ class ClosedFormSegment final : public detail::Segment {
   }
 
   HybridState state(double tau) const override { return flow_.state(tau); }
+  double measured_at(const Parameters&, double tau) const override { return flow_.measured_at(tau); }
 
   // The exact extremes: the ends and the certified zeros of each moving velocity.
   void extremes(double until, Extremes& x) const override {

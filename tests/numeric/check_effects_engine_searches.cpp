@@ -20,7 +20,13 @@
 //   check_sampling_as_before      the sampling's shortcuts give the bits of what they replace (issue 19):
 //                                 phi12 is phi(1, ·), phi(2, ·); real_of_product is (a * b).real(),
 //                                 with infinities, NaNs and overflow among the operands; a contact
-//                                 state is placed at θR + theta_o_error().constant + z(0).
+//                                 state is placed at θR + theta_o_error().constant + z(0);
+//   check_theta_o_alone_as_the_state
+//                                 a flow's θo alone (ModeFlow::measured_at) is measured(p, state(τ)) bit
+//                                 for bit, on every contact and free mode of cases I, II (at the motor)
+//                                 and V, VIII (at the load) with each motor form, from random starts; a
+//                                 run sampling θo alone (SimulationOptions::sample_theta_o_only) has the
+//                                 full run's θo samples and events, its other fields NaN.
 #include "effects/effect_modes.hpp"
 #include "effects/effects_engine.hpp"
 #include "evaluators/phi_functions.hpp"
@@ -251,4 +257,70 @@ TEST(EffectsEngineSearches, check_sampling_as_before) {
     }
   }
   EXPECT_GT(contacts, 0);
+}
+
+TEST(EffectsEngineSearches, check_theta_o_alone_as_the_state) {
+  std::mt19937 random(33);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  std::vector<numeric::Effects> sets(4);
+  sets[1].coulomb_motor = 0.01, sets[1].coulomb_load = 0.02;                          // stuck and slipping shafts
+  sets[2].saturation = 0.05, sets[2].torque_offset = 0.03;                            // a clipped drive
+  sets[3].coulomb_load = 0.02, sets[3].saturation = 0.8, sets[3].torque_offset = -0.01;
+  int free_at_motor = 0, free_at_load = 0, contacts = 0;
+  for (const char* id : {"I", "II", "V", "VIII"}) {
+    const numeric::Parameters p = numeric::parameters_of(model::load_case(id));
+    for (const numeric::Effects& e : sets)
+      for (const numeric::Mode& m : numeric::reachable_modes(p, e)) {
+        if (m.kind == numeric::ModeKind::Mesh) continue;
+        for (int trial = 0; trial < 6; ++trial) {
+          numeric::HybridState start;
+          if (m.kind == numeric::ModeKind::Contact) {
+            start = numeric::state_on_face(p, m.face, 0.6 + 0.3 * unit(random), m.slip_motor * std::fabs(unit(random)), true);
+          } else {
+            start.theta_m = 0.6 + 0.3 * unit(random);
+            start.theta_L = start.theta_m + 0.5 * p.backlash * unit(random);
+            start.dtheta_m = m.slip_motor == 0 ? 0 : unit(random);
+            start.dtheta_L = m.slip_load == 0 ? 0 : unit(random);
+            start.face = m.face;
+          }
+          const numeric::ModeFlow flow(p, e, m, start);
+          for (double tau : {0.0, 1e-3, 0.3, 2.0, 17.0}) {
+            const double got = flow.measured_at(tau), expected = numeric::measured(p, flow.state(tau));
+            EXPECT_TRUE(same_bits(got, expected))
+                << "case " << id << ", " << m.describe() << ", tau " << tau << ": returned " << got << " instead of " << expected;
+          }
+          if (m.kind == numeric::ModeKind::Contact) ++contacts;
+          else if (p.measured_at == model::MeasuredAt::Motor) ++free_at_motor;
+          else ++free_at_load;
+        }
+      }
+  }
+  EXPECT_GT(contacts, 0);
+  EXPECT_GT(free_at_motor, 0);
+  EXPECT_GT(free_at_load, 0);
+  // Whole runs: the samples of θo alone against the full ones.
+  for (const char* id : {"I", "V"}) {
+    const model::CaseSpec spec = model::load_case(id);
+    const numeric::ValidationResult nominal = numeric::validate(numeric::case_evaluator(spec));
+    ASSERT_TRUE(nominal.passed());
+    const numeric::EffectValidationResult gate = numeric::validate_effects(nominal.evaluator(), sets[3]);
+    ASSERT_TRUE(gate.passed()) << id;
+    numeric::SimulationOptions full;
+    full.t_end = 30;
+    for (int k = 0; k <= 3000; ++k) full.sample_times.push_back(0.01 * k);
+    numeric::SimulationOptions alone = full;
+    alone.sample_theta_o_only = true;
+    const numeric::SimulationResult a = numeric::simulate_effects_step(gate.model(), 0.62, full, {.general_engine = true});
+    const numeric::SimulationResult b = numeric::simulate_effects_step(gate.model(), 0.62, alone, {.general_engine = true});
+    ASSERT_EQ(a.samples.size(), full.sample_times.size()) << id;
+    ASSERT_EQ(b.samples.size(), a.samples.size()) << id;
+    ASSERT_EQ(b.events.size(), a.events.size()) << id;
+    EXPECT_GT(a.events.size(), 2u) << id;
+    for (std::size_t k = 0; k < a.samples.size(); ++k) {
+      EXPECT_TRUE(same_bits(a.samples[k].t, b.samples[k].t) && same_bits(a.samples[k].theta_o, b.samples[k].theta_o))
+          << "case " << id << ", sample " << k << ": returned " << b.samples[k].theta_o << " instead of " << a.samples[k].theta_o;
+      EXPECT_TRUE(std::isnan(b.samples[k].theta_m) && std::isnan(b.samples[k].dtheta_L)) << id << ", sample " << k;
+    }
+    for (std::size_t i = 0; i < a.events.size(); ++i) EXPECT_TRUE(same_bits(a.events[i].t, b.events[i].t)) << id << ", event " << i;
+  }
 }

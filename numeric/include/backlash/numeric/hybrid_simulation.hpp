@@ -117,6 +117,11 @@ struct SimulationOptions {
     double low, high;
   };
   std::optional<SampleBand> sample_band;
+  /// Set: the samples carry t and θo alone (the other fields NaN, in_contact false), for a sink
+  /// that reads nothing else (a fit to a record of θo); a closed-form free flight then forms only
+  /// the measured shaft's terms, with the bits of the full state's θo.  Honoured by the effects
+  /// engine; the other simulators fill every field.
+  bool sample_theta_o_only = false;
 };
 
 /// Exact extremes over the simulated time: at event states and at the certified
@@ -173,7 +178,8 @@ void include_extremes(const Parameters& p, const HybridState& s, Extremes& x);
 class TrajectoryRecorder {
  public:
   TrajectoryRecorder(const Parameters& p, const SimulationOptions& o, SimulationResult& r) : p_(p), o_(o), r_(r) {}
-  /// Samples at the global times ≤ t_upto of a segment that starts at t0; `at(τ)` is its state at τ = t − t0.
+  /// Samples at the global times ≤ t_upto of a segment that starts at t0; `at(τ)` is its state at
+  /// τ = t − t0 (a HybridState), or its θo alone (a double: SimulationOptions::sample_theta_o_only).
   template <class At>
   void record(double t0, double t_upto, const At& at) {
     if (!o_.sample_times.empty()) {
@@ -241,6 +247,11 @@ class TrajectoryRecorder {
   }
 
  private:
+  void push(double t, double theta_o) {  // SimulationOptions::sample_theta_o_only
+    const TrajectorySample sample{t, theta_o, NAN, NAN, NAN, NAN, NAN, false};
+    if (o_.sample_sink) o_.sample_sink(sample);
+    else r_.samples.push_back(sample);
+  }
   void push(double t, const HybridState& h) {
     const TrajectorySample sample{t, measured(p_, h), measured_velocity(p_, h), h.theta_m, h.dtheta_m, h.theta_L,
                                   h.dtheta_L, h.in_contact};
