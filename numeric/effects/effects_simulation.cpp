@@ -245,6 +245,17 @@ class ExitSearch {
   }
 
   bool immediate() const { return immediate_; }
+  /// The witness's rate w'(τ) = eᵀA z(τ) + eᵀc is positive beyond the closed form's rounding
+  /// (kSampleNoise of its terms, as the search's own allowance): the exact rate is positive too.
+  bool rising_at(double tau) const {
+    const SmallVector& z = memo_.local(tau);
+    const double rate = dot(mode_->eA, z) + mode_->ec;
+    return rate > detail::kSampleNoise * (abs_dot(mode_->eA, z) + std::fabs(mode_->ec));
+  }
+  /// The search passed up to `until` without asking it, where it is known to find nothing.
+  void pass_until(double until) {
+    if (!finished_ && from_ < until) from_ = until;
+  }
   /// The witness starts on its boundary and leaves it toward w > 0, w(τ) > 0 certified where its
   /// search starts (classify_start).
   bool departs() const { return departs_; }
@@ -290,8 +301,8 @@ class ExitSearch {
   bool finished_ = false, immediate_ = false, departs_ = false;
 };
 
-// Whether a free flight's return to the face left is not searched before the opposite face's
-// crossing (detail::OneTurn): the mode's gap rate has at most two real zeros
+// Whether a free flight's return to the face left is not searched where it is proved to find
+// nothing (detail::OneTurn, first_exit_one_turn): the mode's gap rate has at most two real zeros
 // (free_gap_turns_once), one of them the start (both bodies at one velocity in the flow's own
 // start, so the gap rate is exactly 0 there), and the flight leaves the face toward the opposite
 // one; the opposite face's guard is searched first in every window (docs/effects.md).
@@ -305,29 +316,33 @@ bool one_turn_applies(detail::OneTurn one_turn, const Parameters& p, const Effec
   return detail::free_gap_turns_once(p, e, flow.mode()) && z0(1) == z0(3);
 }
 
+// The later guards' searches (from index `first` on) in one window, as the segment's loop asks
+// them: each up to the window's end `b` or to the exit found before it, the earliest kept.
+void search_window(std::vector<ExitSearch>& searches, std::size_t first, double b, std::optional<Exit>& exit) {
+  for (std::size_t i = first; i < searches.size(); ++i) {
+    const std::optional<Exit> candidate = searches[i].search_until(exit ? exit->tau : b);
+    if (candidate && (!exit || candidate->tau < exit->tau)) exit = candidate;
+  }
+}
+
 // The first exit of a free flight whose gap turns at most once (one_turn_applies), as the
-// segment's loop over the windows finds it (ClosedFormSegment): searches[0], the opposite face's
-// guard, is first in every window and so asked up to each window's end, whatever the others find:
-// searched ahead alone it is asked exactly what the loop would ask.  When it finds a crossing,
-// the return's guard searches[1] is left out up to it: every range the loop would ask it lies
-// before that crossing, where the gap is proved not to return (docs/effects.md, "A flight whose
-// gap turns at most once"); without a crossing, searches[1] is searched as in the loop.
+// segment's loop over the windows finds it (ClosedFormSegment), the windows in the loop's order:
+// searches[0], the opposite face's guard, first; the return's guard searches[1] is not asked where
+// it is proved to find nothing (docs/effects.md, "A flight whose gap turns at most once") — in
+// the window where the opposite face is crossed (every range it would be asked lies before the
+// crossing), and in a window at whose end its witness still rises (the gap has not turned yet).
 [[gnu::noinline]] std::optional<Exit> first_exit_one_turn(std::vector<ExitSearch>& searches, double horizon,
                                                           double first_window) {
-  std::optional<Exit> ahead, exit;
-  int ahead_window = -1, j = 0;
+  std::optional<Exit> exit;
   double window = first_window;
-  for (double a = 0; a < horizon && !ahead; a += window, window *= 2, ++j)
-    if ((ahead = searches[0].search_until(std::min(horizon, a + window)))) ahead_window = j;
-  window = first_window;
-  j = 0;
-  for (double a = 0; a < horizon && !exit; a += window, window *= 2, ++j) {
+  for (double a = 0; a < horizon && !exit; a += window, window *= 2) {
     const double b = std::min(horizon, a + window);
-    if (j == ahead_window) exit = ahead;
-    for (std::size_t i = ahead ? 2 : 1; i < searches.size(); ++i) {
-      const std::optional<Exit> candidate = searches[i].search_until(exit ? exit->tau : b);
-      if (candidate && (!exit || candidate->tau < exit->tau)) exit = candidate;
-    }
+    exit = searches[0].search_until(b);
+    if (!exit && searches[1].rising_at(b))
+      searches[1].pass_until(b);
+    else if (!exit)
+      exit = searches[1].search_until(b);
+    search_window(searches, 2, b, exit);
   }
   return exit;
 }
@@ -364,14 +379,11 @@ class ClosedFormSegment final : public detail::Segment {
       }
     }
     double window = std::min(horizon, 0.125 * servo_period(p));
-    if (one_turn_applies(one_turn, p, e, flow_, witnesses, searches)) exit = first_exit_one_turn(searches, horizon, window);
-    for (double a = 0; a < horizon && !exit; a += window, window *= 2) {
-      const double b = std::min(horizon, a + window);
-      for (ExitSearch& search : searches) {
-        const std::optional<Exit> candidate = search.search_until(exit ? exit->tau : b);
-        if (candidate && (!exit || candidate->tau < exit->tau)) exit = candidate;
-      }
-    }
+    if (one_turn_applies(one_turn, p, e, flow_, witnesses, searches))
+      exit = first_exit_one_turn(searches, horizon, window);
+    else
+      for (double a = 0; a < horizon && !exit; a += window, window *= 2)
+        search_window(searches, 0, std::min(horizon, a + window), exit);
     if (exit) duration = exit->tau;
     if (exit && exit->witness.guard == Guard::Handover) exit.reset();  // the segment ends there, the mode goes on
   }
