@@ -316,15 +316,6 @@ bool one_turn_applies(detail::OneTurn one_turn, const Parameters& p, const Effec
   return detail::free_gap_turns_once(p, e, flow.mode()) && z0(1) == z0(3);
 }
 
-// The later guards' searches (from index `first` on) in one window, as the segment's loop asks
-// them: each up to the window's end `b` or to the exit found before it, the earliest kept.
-void search_window(std::vector<ExitSearch>& searches, std::size_t first, double b, std::optional<Exit>& exit) {
-  for (std::size_t i = first; i < searches.size(); ++i) {
-    const std::optional<Exit> candidate = searches[i].search_until(exit ? exit->tau : b);
-    if (candidate && (!exit || candidate->tau < exit->tau)) exit = candidate;
-  }
-}
-
 // The first exit of a free flight whose gap turns at most once (one_turn_applies), as the
 // segment's loop over the windows finds it (ClosedFormSegment), the windows in the loop's order:
 // searches[0], the opposite face's guard, first; the return's guard searches[1] is not asked where
@@ -342,7 +333,10 @@ void search_window(std::vector<ExitSearch>& searches, std::size_t first, double 
       searches[1].pass_until(b);
     else if (!exit)
       exit = searches[1].search_until(b);
-    search_window(searches, 2, b, exit);
+    for (std::size_t i = 2; i < searches.size(); ++i) {
+      const std::optional<Exit> candidate = searches[i].search_until(exit ? exit->tau : b);
+      if (candidate && (!exit || candidate->tau < exit->tau)) exit = candidate;
+    }
   }
   return exit;
 }
@@ -379,11 +373,14 @@ class ClosedFormSegment final : public detail::Segment {
       }
     }
     double window = std::min(horizon, 0.125 * servo_period(p));
-    if (one_turn_applies(one_turn, p, e, flow_, witnesses, searches))
-      exit = first_exit_one_turn(searches, horizon, window);
-    else
-      for (double a = 0; a < horizon && !exit; a += window, window *= 2)
-        search_window(searches, 0, std::min(horizon, a + window), exit);
+    if (one_turn_applies(one_turn, p, e, flow_, witnesses, searches)) exit = first_exit_one_turn(searches, horizon, window);
+    for (double a = 0; a < horizon && !exit; a += window, window *= 2) {
+      const double b = std::min(horizon, a + window);
+      for (ExitSearch& search : searches) {
+        const std::optional<Exit> candidate = search.search_until(exit ? exit->tau : b);
+        if (candidate && (!exit || candidate->tau < exit->tau)) exit = candidate;
+      }
+    }
     if (exit) duration = exit->tau;
     if (exit && exit->witness.guard == Guard::Handover) exit.reset();  // the segment ends there, the mode goes on
   }
