@@ -282,10 +282,14 @@ class ExitSearch {
 
  private:
   std::optional<Crossing> search(double until) const {
+    // The memo's state itself, not a copy (the same bits as WitnessSample's).
+    struct StateSample {
+      const SmallVector& x;
+      double value;
+    };
     const auto sample = [this](double tau) {
-      WitnessSample s{memo_.local(tau), 0};
-      s.value = dot(mode_->e, s.x);
-      return s;
+      const SmallVector& x = memo_.local(tau);
+      return StateSample{x, dot(mode_->e, x)};
     };
     return detail::search(detail::Sampler<decltype(sample)>(*mode_, sample, level_), bound_ ? &bound_ : nullptr, from_,
                           until, CrossingOptions{});
