@@ -185,7 +185,9 @@ const WitnessMode& kept_witness_mode(const SmallMatrix& A, const SmallVector& c,
 bool free_gap_turns_once(const Parameters& p, const Effects& e, const Mode& m);
 
 /// Whether a closed-form segment leaves out the search for the return to the face a flight left
-/// before the opposite face's crossing (docs/effects.md, "A flight whose gap turns at most once"):
+/// where it is proved to find nothing — the window of the opposite face's crossing, a window at
+/// whose end the gap still moves away from the face left (docs/effects.md, "A flight whose gap
+/// turns at most once"):
 /// `Proved` where free_gap_turns_once holds and the flight starts with one velocity for both
 /// bodies, `Off` never; `Forced` wherever the two gap guards are searched (tests only: where the
 /// proof does not hold it misses returns).

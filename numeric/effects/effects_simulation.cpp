@@ -245,6 +245,17 @@ class ExitSearch {
   }
 
   bool immediate() const { return immediate_; }
+  /// The witness's rate w'(τ) = eᵀA z(τ) + eᵀc is positive beyond the closed form's rounding
+  /// (kSampleNoise of its terms, as the search's own allowance): the exact rate is positive too.
+  bool rising_at(double tau) const {
+    const SmallVector& z = memo_.local(tau);
+    const double rate = dot(mode_->eA, z) + mode_->ec;
+    return rate > detail::kSampleNoise * (abs_dot(mode_->eA, z) + std::fabs(mode_->ec));
+  }
+  /// The search passed up to `until` without asking it, where it is known to find nothing.
+  void pass_until(double until) {
+    if (!finished_ && from_ < until) from_ = until;
+  }
   /// The witness starts on its boundary and leaves it toward w > 0, w(τ) > 0 certified where its
   /// search starts (classify_start).
   bool departs() const { return departs_; }
@@ -271,10 +282,14 @@ class ExitSearch {
 
  private:
   std::optional<Crossing> search(double until) const {
+    // The memo's state itself, not a copy (the same bits as WitnessSample's).
+    struct StateSample {
+      const SmallVector& x;
+      double value;
+    };
     const auto sample = [this](double tau) {
-      WitnessSample s{memo_.local(tau), 0};
-      s.value = dot(mode_->e, s.x);
-      return s;
+      const SmallVector& x = memo_.local(tau);
+      return StateSample{x, dot(mode_->e, x)};
     };
     return detail::search(detail::Sampler<decltype(sample)>(*mode_, sample, level_), bound_ ? &bound_ : nullptr, from_,
                           until, CrossingOptions{});
@@ -290,8 +305,8 @@ class ExitSearch {
   bool finished_ = false, immediate_ = false, departs_ = false;
 };
 
-// Whether a free flight's return to the face left is not searched before the opposite face's
-// crossing (detail::OneTurn): the mode's gap rate has at most two real zeros
+// Whether a free flight's return to the face left is not searched where it is proved to find
+// nothing (detail::OneTurn, first_exit_one_turn): the mode's gap rate has at most two real zeros
 // (free_gap_turns_once), one of them the start (both bodies at one velocity in the flow's own
 // start, so the gap rate is exactly 0 there), and the flight leaves the face toward the opposite
 // one; the opposite face's guard is searched first in every window (docs/effects.md).
@@ -306,25 +321,23 @@ bool one_turn_applies(detail::OneTurn one_turn, const Parameters& p, const Effec
 }
 
 // The first exit of a free flight whose gap turns at most once (one_turn_applies), as the
-// segment's loop over the windows finds it (ClosedFormSegment): searches[0], the opposite face's
-// guard, is first in every window and so asked up to each window's end, whatever the others find:
-// searched ahead alone it is asked exactly what the loop would ask.  When it finds a crossing,
-// the return's guard searches[1] is left out up to it: every range the loop would ask it lies
-// before that crossing, where the gap is proved not to return (docs/effects.md, "A flight whose
-// gap turns at most once"); without a crossing, searches[1] is searched as in the loop.
+// segment's loop over the windows finds it (ClosedFormSegment), the windows in the loop's order:
+// searches[0], the opposite face's guard, first; the return's guard searches[1] is not asked where
+// it is proved to find nothing (docs/effects.md, "A flight whose gap turns at most once") — in
+// the window where the opposite face is crossed (every range it would be asked lies before the
+// crossing), and in a window at whose end its witness still rises (the gap has not turned yet).
 [[gnu::noinline]] std::optional<Exit> first_exit_one_turn(std::vector<ExitSearch>& searches, double horizon,
                                                           double first_window) {
-  std::optional<Exit> ahead, exit;
-  int ahead_window = -1, j = 0;
+  std::optional<Exit> exit;
   double window = first_window;
-  for (double a = 0; a < horizon && !ahead; a += window, window *= 2, ++j)
-    if ((ahead = searches[0].search_until(std::min(horizon, a + window)))) ahead_window = j;
-  window = first_window;
-  j = 0;
-  for (double a = 0; a < horizon && !exit; a += window, window *= 2, ++j) {
+  for (double a = 0; a < horizon && !exit; a += window, window *= 2) {
     const double b = std::min(horizon, a + window);
-    if (j == ahead_window) exit = ahead;
-    for (std::size_t i = ahead ? 2 : 1; i < searches.size(); ++i) {
+    exit = searches[0].search_until(b);
+    if (!exit && searches[1].rising_at(b))
+      searches[1].pass_until(b);
+    else if (!exit)
+      exit = searches[1].search_until(b);
+    for (std::size_t i = 2; i < searches.size(); ++i) {
       const std::optional<Exit> candidate = searches[i].search_until(exit ? exit->tau : b);
       if (candidate && (!exit || candidate->tau < exit->tau)) exit = candidate;
     }

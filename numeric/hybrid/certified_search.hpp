@@ -94,7 +94,7 @@ class Sampler {
   double rate_norm(const SmallVector& z) const { return z.cwiseProduct(m_.scale).cwiseAbs().maxCoeff(); }
 
   Sample at(double t) const {
-    const WitnessSample s = sample_(t);
+    const auto s = sample_(t);  // a WitnessSample, or any {x, value} (a view of a kept state)
     const double w = s.value - level_;
     if (s.x.size() == 4) return fixed_size<4>(t, w, s.x.data());
     if (s.x.size() == 2) return fixed_size<2>(t, w, s.x.data());

@@ -1,14 +1,15 @@
 // Issue 19, the effects engine per event: a free flight whose added torques are constant over its
 // segment (the offset, a clipped drive, Coulomb friction while the slip holds) and whose gap rate
 // has at most two real zeros (effects_engine.hpp, free_gap_turns_once; docs/effects.md, "A flight
-// whose gap turns at most once") does not search the return to the face it left before the
-// opposite face's crossing.  On random parameter sets (output at the load; at the motor with an
+// whose gap turns at most once") does not search the return to the face it left where that search
+// is proved to find nothing: in the window of the opposite face's crossing, and in a window at
+// whose end the gap still moves away from the face left.  On random parameter sets (output at the load; at the motor with an
 // over-damped motor) and random flights leaving a face at one velocity for both bodies, with each
 // constant-torque effect, the segment's exit must be the one of the searches without the shortcut,
 // bit for bit, and a dense scan of the exact gap up to an opposite face's crossing must find no
 // return.  The shortcut forced onto flights the proof excludes (an under-damped motor at the
 // output, a slipping load's Coulomb torque with a linear drive) misses returns — so the
-// comparison can fail.
+// comparison can fail (the under-damped motor's, asserted).
 #include "effects/effects_engine.hpp"
 #include "gap_turns_once_parameters.hpp"
 
@@ -97,7 +98,7 @@ int dense_returns(const Parameters& p, const detail::Segment& segment, int face,
 }
 
 struct Tally {
-  long flights = 0, differ = 0, skipped = 0, returns = 0;
+  long flights = 0, differ = 0, skipped = 0, returns = 0, same_face = 0;
 };
 
 void run_flights(Effect effect, int kind, OneTurn one_turn, int sets, Tally& tally) {
@@ -119,6 +120,7 @@ void run_flights(Effect effect, int kind, OneTurn one_turn, int sets, Tally& tal
       }
       if (one_turn == OneTurn::Proved && !proved) continue;
       tally.skipped += with->exit && with->exit->witness.guard == Guard::GapOpposite;
+      tally.same_face += with->exit && with->exit->witness.guard == Guard::GapSame;
       const double scale = std::max({1.0, std::fabs(f->start.theta_m), std::fabs(f->start.theta_L)});
       tally.returns += dense_returns(p, *with, f->start.face, with->duration, 1e-12 * scale) > 0;
     }
@@ -131,10 +133,13 @@ TEST(EffectsGapTurnsOnce, item19_constant_torques_give_the_unshortened_searches_
       Tally tally;
       run_flights(effect, kind, OneTurn::Proved, 30, tally);
       const int id = static_cast<int>(effect);
-      std::printf("effect %d kind %d: %ld flights, %ld ended at the opposite face with the shortcut, %ld differ\n", id, kind,
-                  tally.flights, tally.skipped, tally.differ);
+      std::printf("effect %d kind %d: %ld flights, %ld ended at the opposite face with the shortcut, %ld returned to "
+                  "the face left, %ld differ\n",
+                  id, kind, tally.flights, tally.skipped, tally.same_face, tally.differ);
       if (effect != Effect::CoulombLoad) {
         EXPECT_GT(tally.skipped, 40) << "effect " << id << " kind " << kind;
+        // Returns are found where the gap has turned (the return's search is left out only while it rises).
+        EXPECT_GT(tally.same_face, 5) << "effect " << id << " kind " << kind;
       }
       EXPECT_EQ(tally.differ, 0) << "effect " << id << " kind " << kind << ": exits not the unshortened searches' of "
                                  << tally.flights;
@@ -173,14 +178,16 @@ TEST(EffectsGapTurnsOnce, item19_a_clipped_drive_covers_the_loads_coulomb_torque
 
 TEST(EffectsGapTurnsOnce, item19_forced_where_the_proof_does_not_hold_the_shortcut_misses_returns) {
   Tally tally;
-  for (Effect effect : {Effect::TorqueOffset, Effect::CoulombMotor}) run_flights(effect, 2, OneTurn::Forced, 40, tally);
+  for (Effect effect : {Effect::TorqueOffset, Effect::CoulombMotor}) run_flights(effect, 2, OneTurn::Forced, 80, tally);
   std::printf("forced, under-damped: %ld flights, %ld differ, %ld returns missed\n", tally.flights, tally.differ, tally.returns);
+  // A slipping load's Coulomb torque with a linear drive (degree 4, not proved, so never shortened
+  // in a run: the first test's EXPECT_EQ on free_gap_turns_once): forced here, reported only — the
+  // return's search is left out where the gap still rises at a window's end, and these draws miss
+  // no return that way (fx19g's look-ahead to the crossing missed 24 of 197).
   Tally load;
   run_flights(Effect::CoulombLoad, 0, OneTurn::Forced, 40, load);
   std::printf("forced, Coulomb load, linear drive: %ld flights, %ld differ, %ld returns missed\n", load.flights, load.differ,
               load.returns);
-  EXPECT_GT(load.differ, 0) << "of " << load.flights << " flights";
-  EXPECT_GT(load.returns, 0) << "of " << load.flights << " flights";
   EXPECT_GT(tally.differ, 0) << "of " << tally.flights << " flights";
   EXPECT_GT(tally.returns, 0) << "of " << tally.flights << " flights";
 }
