@@ -424,8 +424,12 @@ class DelayedSegment final : public Segment {
     return h;
   }
 
+  // The coordinate of z that is θo less its start.
+  int theta_o_index() const {
+    return m_.kind == ModeKind::Contact ? 0 : (p_.measured_at == model::MeasuredAt::Motor ? 0 : 2);
+  }
   Jet theta_o_jet(const SmallVector& z, const SmallVector& z1, const SmallVector& z2) const {
-    const int i = m_.kind == ModeKind::Contact ? 0 : (p_.measured_at == model::MeasuredAt::Motor ? 0 : 2);
+    const int i = theta_o_index();
     return {measured(p_, start_) + z(i), z1(i), z2(i)};
   }
 
@@ -565,14 +569,9 @@ class DelayedSegment final : public Segment {
       for (int i = 0; i < n_; ++i) step.z[i] = Quintic(ta, t, {za(i), za1(i), za2(i)}, {zb(i), zb1(i), zb2(i)});
       const double kept_until = check_step(steps_.back(), arming, tolerances);
       const Step& kept = steps_.back();
-      SmallVector ze(n_), ze1(n_), ze2(n_);
-      for (int i = 0; i < n_; ++i) {
-        const Jet j = kept.z[i].at(kept_until);
-        ze(i) = j.value;
-        ze1(i) = j.rate;
-        ze2(i) = j.acceleration;
-      }
-      line_.append(ta, kept_until, theta_o_jet(za, za1, za2), theta_o_jet(ze, ze1, ze2));
+      const Jet je = kept.z[theta_o_index()].at(kept_until);  // θo's coordinate alone is recorded
+      line_.append(ta, kept_until, theta_o_jet(za, za1, za2),
+                   {measured(p_, start_) + je.value, je.rate, je.acceleration});
       za = zb;
       za1 = zb1;
       za2 = zb2;
