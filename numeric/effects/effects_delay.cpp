@@ -28,11 +28,11 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <deque>
 #include <limits>
 #include <map>
 #include <set>
 #include <string>
+#include <vector>
 
 namespace backlash::numeric::detail {
 
@@ -68,6 +68,16 @@ class Quintic {
   }
   double start() const { return t0_; }
   double end() const { return t0_ + h_; }
+  /// at(t).value alone (the same operations, so the same bits).
+  double value(double t) const { return h_ <= 0 ? a_[0] : value_at_fraction((t - t0_) / h_); }
+  /// The value at t0 + s·h (h > 0): value(t) with s = (t − t0)/h formed once for pieces that
+  /// share t0 and h.
+  double value_at_fraction(double s) const {
+    double v = a_[5];
+    for (int k = 4; k >= 0; --k) v = v * s + a_[k];
+    return v;
+  }
+  double length() const { return h_; }
   Jet at(double t) const {
     if (h_ <= 0) return {a_[0], 0, 0};
     const double s = (t - t0_) / h_;
@@ -83,11 +93,34 @@ class Quintic {
   std::array<double, 6> a_{};
 };
 
+// One integration step of a segment: z on [t0, t1], each coordinate a quintic.
+struct Step {
+  double t0, t1;
+  std::array<Quintic, 4> z;  // all on the same [t0, t0 + h]
+
+  /// The first n coordinates at t, each z[i].value(t) (the fraction (t − t0)/h formed once).
+  void values(double t, int n, SmallVector& out) const {
+    if (!(z[0].length() > 0)) {
+      for (int i = 0; i < n; ++i) out(i) = z[i].value(t);
+      return;
+    }
+    const double s = (t - z[0].start()) / z[0].length();
+    for (int i = 0; i < n; ++i) out(i) = z[i].value_at_fraction(s);
+  }
+};
+
 // The history of θo and the delayed drive read from it.
 class DelayLine {
  public:
   DelayLine(const Parameters& p, const Effects& e, double theta_o0, long max_steps)
-      : p_(p), e_(e), initial_(theta_o0), max_steps_(max_steps) {}
+      : p_(p),
+        e_(e),
+        initial_(theta_o0),
+        max_steps_(max_steps),
+        saturating_(e.saturating()),
+        offset_(drive_constant(e, 0)),
+        high_(saturating_ ? drive_constant(e, 1) : 0),
+        low_(saturating_ ? drive_constant(e, -1) : 0) {}
 
   /// Counts one integration step against the run's budget (SearchBudgetExhausted beyond it).
   void count_step(double t, double dt_max) {
@@ -100,12 +133,12 @@ class DelayLine {
     throw SearchBudgetExhausted(text);
   }
 
-  double end() const { return pieces_.empty() ? 0.0 : pieces_.back().end(); }
+  double end() const { return empty() ? 0.0 : pieces_.back().end(); }
   double last_motion() const { return last_motion_; }
 
   /// Appends θo on [t0, t1]; anything recorded beyond t0 is dropped first.
   void append(double t0, double t1, const Jet& y0, const Jet& y1) {
-    while (!pieces_.empty() && pieces_.back().start() >= t0) pieces_.pop_back();
+    while (!empty() && pieces_.back().start() >= t0) pieces_.pop_back();
     forget_before(t0 - e_.delay);
     if (!(t1 > t0)) return;
     pieces_.emplace_back(t0, t1, y0, y1);
@@ -114,12 +147,15 @@ class DelayLine {
   }
 
   Jet theta_o(double s) const {
-    if (s <= 0 || pieces_.empty()) return {initial_, 0, 0};
-    std::size_t k = std::min(cursor_, pieces_.size() - 1);
-    while (k > 0 && pieces_[k].start() > s) --k;
-    while (k + 1 < pieces_.size() && pieces_[k].end() < s) ++k;
-    cursor_ = k;
-    return pieces_[k].at(std::min(s, pieces_[k].end()));
+    if (s <= 0 || empty()) return {initial_, 0, 0};
+    const Quintic& piece = locate(s);
+    return piece.at(std::min(s, piece.end()));
+  }
+  /// theta_o(s).value alone.
+  double theta_o_value(double s) const {
+    if (s <= 0 || empty()) return initial_;
+    const Quintic& piece = locate(s);
+    return piece.value(std::min(s, piece.end()));
   }
 
   double demand(double t) const { return p_.K * (p_.theta_R - theta_o(t - e_.delay).value); }
@@ -132,9 +168,25 @@ class DelayLine {
   Jet drive(double t) const {
     const Jet y = theta_o(t - e_.delay);
     const double d = p_.K * (p_.theta_R - y.value);
-    if (e_.saturating() && std::fabs(d) > e_.saturation) return {drive_constant(e_, d > 0 ? 1 : -1), 0, 0};
-    return {d + drive_constant(e_, 0), -p_.K * y.rate, -p_.K * y.acceleration};
+    if (saturating_ && std::fabs(d) > e_.saturation) return {d > 0 ? high_ : low_, 0, 0};
+    return {d + offset_, -p_.K * y.rate, -p_.K * y.acceleration};
   }
+  /// drive(t).value alone (the integrator's right-hand side and the witnesses need no more).
+  double drive_value(double t) const {
+    const double d = p_.K * (p_.theta_R - theta_o_value(t - e_.delay));
+    if (saturating_ && std::fabs(d) > e_.saturation) return d > 0 ? high_ : low_;
+    return d + offset_;
+  }
+
+  /// An empty buffer for a segment's steps: the one the last segment gave back, so that a run
+  /// allocates for its longest segment only.
+  std::vector<Step> take_steps() {
+    std::vector<Step> steps;
+    steps.swap(spare_steps_);
+    steps.clear();
+    return steps;
+  }
+  void give_back(std::vector<Step>&& steps) { spare_steps_ = std::move(steps); }
 
   /// The times where the delayed demand crosses ±L, with the regime after each.
   const std::map<double, int>& regime_changes() const { return changes_; }
@@ -149,20 +201,38 @@ class DelayLine {
   // regime changes before t0 have been reported.
   void forget_before(double s) {
     std::size_t dropped = 0;
-    while (pieces_.size() > 1 && pieces_.front().end() < s) {
-      pieces_.pop_front();
+    while (pieces_.size() - first_ > 1 && pieces_[first_].end() < s) {
+      ++first_;
       ++dropped;
     }
     cursor_ = cursor_ > dropped ? cursor_ - dropped : 0;
+    // The dropped pieces leave the buffer once they are half of it (no allocation per piece).
+    if (first_ >= 64 && 2 * first_ >= pieces_.size()) {
+      pieces_.erase(pieces_.begin(), pieces_.begin() + static_cast<std::ptrdiff_t>(first_));
+      first_ = 0;
+    }
     changes_.erase(changes_.begin(), changes_.lower_bound(s));
   }
+
+  // The piece that holds s, searched from the last one found: on a boundary shared by two pieces
+  // the one found depends on the side the search comes from (kept as it is: the same bits).
+  const Quintic& locate(double s) const {
+    const Quintic* kept = pieces_.data() + first_;
+    const std::size_t n = pieces_.size() - first_;
+    std::size_t k = std::min(cursor_, n - 1);
+    while (k > 0 && kept[k].start() > s) --k;
+    while (k + 1 < n && kept[k].end() < s) ++k;
+    cursor_ = k;
+    return kept[k];
+  }
+  bool empty() const { return pieces_.size() == first_; }
 
   // θo crossing θR ∓ L/K at s makes the demand at s + τ cross ±L.
   void schedule_regime_changes(const Quintic& piece) {
     if (!e_.saturating()) return;
     for (int level_sign : {1, -1}) {
       const double level = p_.theta_R - level_sign * e_.saturation / p_.K;  // demand = level_sign·L there
-      auto f = [&](double s) { return piece.at(s).value - level; };
+      auto f = [&](double s) { return piece.value(s) - level; };
       double a = piece.start(), fa = f(a);
       for (int k = 1; k <= 8; ++k) {
         const double b = piece.start() + (piece.end() - piece.start()) * k / 8, fb = f(b);
@@ -185,13 +255,43 @@ class DelayLine {
   const Effects& e_;
   double initial_;
   long max_steps_, steps_ = 0;
-  std::deque<Quintic> pieces_;
-  mutable std::size_t cursor_ = 0;
+  bool saturating_;
+  double offset_, high_, low_;  // drive_constant(e, 0), and (1), (−1) when saturating
+  std::vector<Quintic> pieces_;  // the history is pieces_[first_], pieces_[first_ + 1], …
+  std::size_t first_ = 0;
+  mutable std::size_t cursor_ = 0;  // counted from first_
   double last_motion_ = 0;
   std::map<double, int> changes_;
+  std::vector<Step> spare_steps_;
 };
 
 using Vector = std::array<double, 4>;
+
+// z' = A z + c + b·D(t) as the integrator's right-hand side, on fixed arrays (sized at compile
+// time for the two dimensions, 2 in contact and 4 otherwise): each row summed in the same order.
+struct FlatSystem {
+  explicit FlatSystem(const ModeSystem& sys) : n(static_cast<int>(sys.segment.A.rows())) {
+    for (int i = 0; i < n; ++i) {
+      c[i] = sys.segment.c(i);
+      b[i] = sys.drive_column(i);
+      for (int j = 0; j < n; ++j) A[4 * i + j] = sys.segment.A(i, j);
+    }
+  }
+  /// dx = A x + c + b·drive; N = n, or 0 for a size known only at run time.
+  template <int N>
+  void apply(const Vector& x, Vector& dx, double drive) const {
+    const int m = N > 0 ? N : n;
+    for (int i = 0; i < m; ++i) {
+      double sum = c[i] + b[i] * drive;
+      for (int j = 0; j < m; ++j) sum += A[4 * i + j] * x[j];
+      dx[i] = sum;
+    }
+    for (int i = m; i < 4; ++i) dx[i] = 0;
+  }
+  int n;
+  std::array<double, 16> A{};  // row i at 4i
+  std::array<double, 4> c{}, b{};
+};
 
 // One mode integrated from the engine's state, with its guards.
 class DelayedSegment final : public Segment {
@@ -199,6 +299,7 @@ class DelayedSegment final : public Segment {
   DelayedSegment(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start, double t0,
                  double horizon, double stop_at, DelayLine& line, int left_zone, double rest_velocity)
       : p_(p), e_(e), m_(m), start_(start), t0_(t0), line_(line), rest_velocity_(rest_velocity) {
+    steps_ = line_.take_steps();
     sys_ = mode_system(p, e, m, start, true);
     n_ = static_cast<int>(sys_.segment.A.rows());
     functionals_.dimension = n_;
@@ -207,6 +308,7 @@ class DelayedSegment final : public Segment {
     functionals_.drive = Functional{SmallRow::Zero(n_), 0, 0, 1};
     functionals_.left_zone = left_zone;
     witnesses_ = mode_witnesses(p, e, m, functionals_, false);
+    witness_buffer_.resize(witnesses_.size());
     const double stop = std::min(t0 + horizon, stop_at);
     const bool stuck = m.kind == ModeKind::Contact ? m.slip_motor == 0 : (m.slip_motor == 0 && m.slip_load == 0);
     if (stuck) {
@@ -217,17 +319,23 @@ class DelayedSegment final : public Segment {
     }
   }
 
+  ~DelayedSegment() override { line_.give_back(std::move(steps_)); }
+  DelayedSegment(const DelayedSegment&) = delete;
+  DelayedSegment& operator=(const DelayedSegment&) = delete;
+
   HybridState state(double tau) const override { return state_of(z_at(t0_ + tau)); }
 
   void extremes(double until, Extremes& x) const override {
     include(state(0), x);
     include(state(until), x);
-    const std::vector<int> rows = m_.kind == ModeKind::Contact ? std::vector<int>{1} : std::vector<int>{1, 3};
+    const int rows[] = {1, 3};  // the velocities: ω in contact, θ̇m and θ̇L in flight
+    const int row_count = m_.kind == ModeKind::Contact ? 1 : 2;
     for (const Step& step : steps_) {
       const double b_end = std::min(step.t1, t0_ + until);
       if (!(b_end > step.t0)) break;
-      for (int row : rows) {
-        auto v = [&](double t) { return step.z[row].at(t).value; };
+      for (int r = 0; r < row_count; ++r) {
+        const int row = rows[r];
+        auto v = [&](double t) { return step.z[row].value(t); };
         double a = step.t0, va = v(a);
         for (int k = 1; k <= samples_per_step; ++k) {
           const double b = step.t0 + (b_end - step.t0) * k / samples_per_step, vb = v(b);
@@ -245,10 +353,6 @@ class DelayedSegment final : public Segment {
   }
 
  private:
-  struct Step {
-    double t0, t1;
-    std::array<Quintic, 4> z;
-  };
 
   Functional theta_o_error() const {
     Functional f{SmallRow::Zero(n_), measured(p_, start_) - p_.theta_R,
@@ -282,9 +386,14 @@ class DelayedSegment final : public Segment {
   }
 
   double witness_value(const Witness& w, const SmallVector& z, double t) const {
+    const double sum = witness_sum(w, z);
+    return w.f.drive_weight != 0 ? sum + w.f.drive_weight * line_.drive_value(t) : sum;
+  }
+  // w without its drive term, row·z + c.
+  double witness_sum(const Witness& w, const SmallVector& z) const {
     double sum = w.f.constant;
     for (int i = 0; i < n_; ++i) sum += w.f.row(i) * z(i);
-    return w.f.drive_weight != 0 ? sum + w.f.drive_weight * line_.drive(t).value : sum;
+    return sum;
   }
 
   SmallVector z_at(double t) const {
@@ -292,7 +401,7 @@ class DelayedSegment final : public Segment {
     auto it = std::upper_bound(steps_.begin(), steps_.end(), t, [](double x, const Step& s) { return x < s.t1; });
     const Step& step = it == steps_.end() ? steps_.back() : *it;
     SmallVector z(n_);
-    for (int i = 0; i < n_; ++i) z(i) = step.z[i].at(std::min(t, step.t1)).value;
+    step.values(std::min(t, step.t1), n_, z);
     return z;
   }
 
@@ -315,8 +424,12 @@ class DelayedSegment final : public Segment {
     return h;
   }
 
+  // The coordinate of z that is θo less its start.
+  int theta_o_index() const {
+    return m_.kind == ModeKind::Contact ? 0 : (p_.measured_at == model::MeasuredAt::Motor ? 0 : 2);
+  }
   Jet theta_o_jet(const SmallVector& z, const SmallVector& z1, const SmallVector& z2) const {
-    const int i = m_.kind == ModeKind::Contact ? 0 : (p_.measured_at == model::MeasuredAt::Motor ? 0 : 2);
+    const int i = theta_o_index();
     return {measured(p_, start_) + z(i), z1(i), z2(i)};
   }
 
@@ -413,14 +526,12 @@ class DelayedSegment final : public Segment {
         return stop;
       }
     }
-    auto rhs = [this](const Vector& x, Vector& dx, double t) {
-      const double drive = line_.drive(t).value;
-      for (int i = 0; i < n_; ++i) {
-        double sum = sys_.segment.c(i) + sys_.drive_column(i) * drive;
-        for (int j = 0; j < n_; ++j) sum += sys_.segment.A(i, j) * x[j];
-        dx[i] = sum;
-      }
-      for (int i = n_; i < 4; ++i) dx[i] = 0;
+    const FlatSystem flat(sys_);
+    auto rhs = [this, &flat](const Vector& x, Vector& dx, double t) {
+      const double drive = line_.drive_value(t);
+      if (flat.n == 4) flat.apply<4>(x, dx, drive);
+      else if (flat.n == 2) flat.apply<2>(x, dx, drive);
+      else flat.apply<0>(x, dx, drive);
     };
     auto stepper = odeint::make_controlled(tolerance, tolerance, odeint::runge_kutta_dopri5<Vector>());
     Vector x{};
@@ -452,19 +563,15 @@ class DelayedSegment final : public Segment {
       SmallVector zb(n_);
       for (int i = 0; i < n_; ++i) zb(i) = x[i];
       const auto [zb1, zb2] = derivatives(zb, t);
-      Step step{ta, t, {}};
+      Step& step = steps_.emplace_back();  // built in place (272 bytes)
+      step.t0 = ta;
+      step.t1 = t;
       for (int i = 0; i < n_; ++i) step.z[i] = Quintic(ta, t, {za(i), za1(i), za2(i)}, {zb(i), zb1(i), zb2(i)});
-      steps_.push_back(step);
       const double kept_until = check_step(steps_.back(), arming, tolerances);
       const Step& kept = steps_.back();
-      SmallVector ze(n_), ze1(n_), ze2(n_);
-      for (int i = 0; i < n_; ++i) {
-        const Jet j = kept.z[i].at(kept_until);
-        ze(i) = j.value;
-        ze1(i) = j.rate;
-        ze2(i) = j.acceleration;
-      }
-      line_.append(ta, kept_until, theta_o_jet(za, za1, za2), theta_o_jet(ze, ze1, ze2));
+      const Jet je = kept.z[theta_o_index()].at(kept_until);  // θo's coordinate alone is recorded
+      line_.append(ta, kept_until, theta_o_jet(za, za1, za2),
+                   {measured(p_, start_) + je.value, je.rate, je.acceleration});
       za = zb;
       za1 = zb1;
       za2 = zb2;
@@ -493,19 +600,32 @@ class DelayedSegment final : public Segment {
   double check_step(const Step& step, std::vector<Arming>& arming, const std::vector<double>& tolerances) {
     auto z_of = [&step, this](double t) {
       SmallVector z(n_);
-      for (int i = 0; i < n_; ++i) z(i) = step.z[i].at(t).value;
+      step.values(t, n_, z);
       return z;
     };
+    // The drive at a sample is read once for all witnesses, as reading it again at the same time
+    // returns it again; it is read afresh after a refinement has read the history elsewhere
+    // (DelayLine::locate's cursor: the same reads in the same order, the same bits).
+    double drive = 0;
+    bool drive_read = false;
+    auto value = [&](const Witness& w, const SmallVector& z, double t) {
+      const double sum = witness_sum(w, z);
+      if (w.f.drive_weight == 0) return sum;
+      if (!drive_read) drive = line_.drive_value(t), drive_read = true;
+      return sum + w.f.drive_weight * drive;
+    };
     double a = step.t0;
-    std::vector<double> wa(witnesses_.size());
-    for (std::size_t i = 0; i < witnesses_.size(); ++i) wa[i] = witness_value(witnesses_[i], z_of(a), a);
+    std::vector<double>& wa = witness_buffer_;
+    const SmallVector z_a = z_of(a);
+    for (std::size_t i = 0; i < witnesses_.size(); ++i) wa[i] = value(witnesses_[i], z_a, a);
+    std::optional<Exit> first;  // empty at every sample: the first exit ends the search
     for (int k = 1; k <= samples_per_step; ++k) {
       const double b = k == samples_per_step ? step.t1 : step.t0 + (step.t1 - step.t0) * k / samples_per_step;
       const SmallVector zb = z_of(b);
-      std::optional<Exit> first;
+      drive_read = false;
       for (std::size_t i = 0; i < witnesses_.size(); ++i) {
         const Witness& w = witnesses_[i];
-        const double wb = witness_value(w, zb, b);
+        const double wb = value(w, zb, b);
         if (arming[i] == Arming::Armed && wa[i] >= 0 && wb < 0) {
           auto f = [&](double t) { return witness_value(w, z_of(t), t); };
           std::uintmax_t iterations = 100;
@@ -513,6 +633,7 @@ class DelayedSegment final : public Segment {
                                                            boost::math::tools::eps_tolerance<double>(50), iterations);
           const double t = 0.5 * (r.first + r.second);
           if (!first || t - t0_ < first->tau) first = Exit{t - t0_, w, false};
+          drive_read = false;
         }
         if ((arming[i] == Arming::Waiting && wb > tolerances[i]) || (arming[i] == Arming::Departing && wb > 0))
           arming[i] = Arming::Armed;
@@ -552,6 +673,7 @@ class DelayedSegment final : public Segment {
   int n_ = 4;
   ModeFunctionals functionals_;
   std::vector<Witness> witnesses_;
+  std::vector<double> witness_buffer_;  // check_step's witness values at the sample before
   std::vector<Step> steps_;
 };
 
