@@ -76,6 +76,14 @@ std::string event_limit_reason(const SimulationOptions& options) {
   return "the event cap of " + std::to_string(options.max_events) + " events was reached";
 }
 
+double measured(const Parameters& p, const HybridState& s) {
+  return p.measured_at == model::MeasuredAt::Motor ? s.theta_m : s.theta_L;
+}
+
+double measured_velocity(const Parameters& p, const HybridState& s) {
+  return p.measured_at == model::MeasuredAt::Motor ? s.dtheta_m : s.dtheta_L;
+}
+
 void include_extremes(const Parameters& p, const HybridState& h, Extremes& x) {
   const double o = measured(p, h);
   x.theta_o_min = std::min(x.theta_o_min, o);

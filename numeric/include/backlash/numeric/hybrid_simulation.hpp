@@ -158,13 +158,9 @@ std::string zeno_reason(const SimulationOptions& options, double window);
 /// The stop reason of a run that reached options.max_events.
 std::string event_limit_reason(const SimulationOptions& options);
 
-/// The measured shaft of a state, and its velocity (inline: formed for every trajectory sample).
-inline double measured(const Parameters& p, const HybridState& s) {
-  return p.measured_at == model::MeasuredAt::Motor ? s.theta_m : s.theta_L;
-}
-inline double measured_velocity(const Parameters& p, const HybridState& s) {
-  return p.measured_at == model::MeasuredAt::Motor ? s.dtheta_m : s.dtheta_L;
-}
+/// The measured shaft of a state, and its velocity.
+double measured(const Parameters& p, const HybridState& s);
+double measured_velocity(const Parameters& p, const HybridState& s);
 
 /// Widens `x` to include the angles θo, θm, θL of the state `s`: the one update of the running
 /// extremes, for every simulator (bookkeeping only, no dynamics).
