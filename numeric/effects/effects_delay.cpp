@@ -109,6 +109,39 @@ struct Step {
   }
 };
 
+// Whether each witness is armed at the start (valid side), exits at once, departs from its
+// boundary inward with a non-zero rate (armed from its first positive sample: a tiny
+// bounce's return is an event however small), or waits until it is clearly inside.
+enum class Arming { Armed, ExitNow, Departing, Waiting };
+
+// A witness's row·z + c on a fixed array (a Functional's row, constant and drive weight).
+struct WitnessRow {
+  explicit WitnessRow(const Functional& f) : constant(f.constant), drive_weight(f.drive_weight) {
+    for (Eigen::Index i = 0; i < f.row.size(); ++i) row[i] = f.row(i);
+  }
+  /// row·z + c summed from c in the order of the coordinates; N = z.size(), or 0 for a size known
+  /// only at run time.
+  template <int N>
+  double sum(const SmallVector& z) const {
+    const int n = N > 0 ? N : static_cast<int>(z.size());
+    double s = constant;
+    for (int i = 0; i < n; ++i) s += row[i] * z(i);
+    return s;
+  }
+  std::array<double, 4> row{};
+  double constant, drive_weight;
+};
+
+// A segment's working storage, handed on from segment to segment (DelayLine::take_buffers).
+struct SegmentBuffers {
+  std::vector<Step> steps;
+  std::vector<Witness> witnesses;
+  std::vector<WitnessRow> witness_rows;  // witnesses[i].f as a WitnessRow
+  std::vector<double> witness_values;  // check_step's witness values at the sample before
+  std::vector<double> tolerances;      // each witness's boundary tolerance (DelayedSegment::arm)
+  std::vector<Arming> arming;
+};
+
 // The history of θo and the delayed drive read from it.
 class DelayLine {
  public:
@@ -178,15 +211,14 @@ class DelayLine {
     return d + offset_;
   }
 
-  /// An empty buffer for a segment's steps: the one the last segment gave back, so that a run
-  /// allocates for its longest segment only.
-  std::vector<Step> take_steps() {
-    std::vector<Step> steps;
-    steps.swap(spare_steps_);
-    steps.clear();
-    return steps;
+  /// Storage for a segment: the one the last segment gave back (steps cleared), so that a run
+  /// allocates for its largest segment only.
+  SegmentBuffers take_buffers() {
+    SegmentBuffers b = std::move(spare_);
+    b.steps.clear();
+    return b;
   }
-  void give_back(std::vector<Step>&& steps) { spare_steps_ = std::move(steps); }
+  void give_back(SegmentBuffers&& b) { spare_ = std::move(b); }
 
   /// The times where the delayed demand crosses ±L, with the regime after each.
   const std::map<double, int>& regime_changes() const { return changes_; }
@@ -262,7 +294,7 @@ class DelayLine {
   mutable std::size_t cursor_ = 0;  // counted from first_
   double last_motion_ = 0;
   std::map<double, int> changes_;
-  std::vector<Step> spare_steps_;
+  SegmentBuffers spare_;
 };
 
 using Vector = std::array<double, 4>;
@@ -270,6 +302,7 @@ using Vector = std::array<double, 4>;
 // z' = A z + c + b·D(t) as the integrator's right-hand side, on fixed arrays (sized at compile
 // time for the two dimensions, 2 in contact and 4 otherwise): each row summed in the same order.
 struct FlatSystem {
+  FlatSystem() = default;
   explicit FlatSystem(const ModeSystem& sys) : n(static_cast<int>(sys.segment.A.rows())) {
     for (int i = 0; i < n; ++i) {
       c[i] = sys.segment.c(i);
@@ -288,7 +321,17 @@ struct FlatSystem {
     }
     for (int i = m; i < 4; ++i) dx[i] = 0;
   }
-  int n;
+  /// Row i of A·z in Eigen's order for a small product of dynamic size (its packet loop,
+  /// ProductEvaluators.h etor_product_packet_impl: from 0, adding A(i, j)·z(j) for j = 0, 1, …).
+  /// N = n, or 0 for a size known only at run time.
+  template <int N>
+  double product(int i, const SmallVector& z) const {
+    const int m = N > 0 ? N : n;
+    double sum = 0;
+    for (int j = 0; j < m; ++j) sum += A[4 * i + j] * z(j);
+    return sum;
+  }
+  int n = 0;
   std::array<double, 16> A{};  // row i at 4i
   std::array<double, 4> c{}, b{};
 };
@@ -298,16 +341,19 @@ class DelayedSegment final : public Segment {
  public:
   DelayedSegment(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start, double t0,
                  double horizon, double stop_at, DelayLine& line, int left_zone, double rest_velocity)
-      : p_(p), e_(e), m_(m), start_(start), t0_(t0), line_(line), rest_velocity_(rest_velocity) {
-    steps_ = line_.take_steps();
+      : p_(p), e_(e), m_(m), start_(start), t0_(t0), line_(line), rest_velocity_(rest_velocity),
+        buffers_(line.take_buffers()) {
     sys_ = mode_system(p, e, m, start, true);
+    flat_ = FlatSystem(sys_);
     n_ = static_cast<int>(sys_.segment.A.rows());
     functionals_.dimension = n_;
     functionals_.theta_o_error = theta_o_error();
     functionals_.gap = gap();
     functionals_.drive = Functional{SmallRow::Zero(n_), 0, 0, 1};
     functionals_.left_zone = left_zone;
-    witnesses_ = mode_witnesses(p, e, m, functionals_, false);
+    mode_witnesses(p, e, m, functionals_, false, witnesses_);
+    witness_rows_.clear();
+    for (const Witness& w : witnesses_) witness_rows_.emplace_back(w.f);
     witness_buffer_.resize(witnesses_.size());
     const double stop = std::min(t0 + horizon, stop_at);
     const bool stuck = m.kind == ModeKind::Contact ? m.slip_motor == 0 : (m.slip_motor == 0 && m.slip_load == 0);
@@ -319,7 +365,7 @@ class DelayedSegment final : public Segment {
     }
   }
 
-  ~DelayedSegment() override { line_.give_back(std::move(steps_)); }
+  ~DelayedSegment() override { line_.give_back(std::move(buffers_)); }
   DelayedSegment(const DelayedSegment&) = delete;
   DelayedSegment& operator=(const DelayedSegment&) = delete;
 
@@ -377,32 +423,50 @@ class DelayedSegment final : public Segment {
     return f;
   }
 
-  // z' and z'' from z at time t: z' = A z + c + b D(t), z'' = A z' + b D'(t).
+  // z' and z'' from z at time t: z' = A z + c + b D(t), z'' = A z' + b D'(t).  Summed as Eigen
+  // sums these products of at most 4 (FlatSystem::product): the bits of the Eigen expressions
+  // (A z + c) + b D and A z' + b D'.
   std::pair<SmallVector, SmallVector> derivatives(const SmallVector& z, double t) const {
     const Jet d = line_.drive(t);
-    const SmallVector z1 = sys_.segment.A * z + sys_.segment.c + sys_.drive_column * d.value;
-    const SmallVector z2 = sys_.segment.A * z1 + sys_.drive_column * d.rate;
+    return n_ == 4 ? derivatives<4>(z, d) : n_ == 2 ? derivatives<2>(z, d) : derivatives<0>(z, d);
+  }
+  template <int N>
+  std::pair<SmallVector, SmallVector> derivatives(const SmallVector& z, const Jet& d) const {
+    const int n = N > 0 ? N : n_;
+    SmallVector z1(n), z2(n);
+    for (int i = 0; i < n; ++i) z1(i) = (flat_.product<N>(i, z) + flat_.c[i]) + flat_.b[i] * d.value;
+    for (int i = 0; i < n; ++i) z2(i) = flat_.product<N>(i, z1) + flat_.b[i] * d.rate;
     return {z1, z2};
   }
 
-  double witness_value(const Witness& w, const SmallVector& z, double t) const {
-    const double sum = witness_sum(w, z);
-    return w.f.drive_weight != 0 ? sum + w.f.drive_weight * line_.drive_value(t) : sum;
+  // Witness i's value at z and t.
+  double witness_value(std::size_t i, const SmallVector& z, double t) const {
+    const double sum = witness_sum(i, z);
+    const double k = witness_rows_[i].drive_weight;
+    return k != 0 ? sum + k * line_.drive_value(t) : sum;
   }
-  // w without its drive term, row·z + c.
-  double witness_sum(const Witness& w, const SmallVector& z) const {
-    double sum = w.f.constant;
-    for (int i = 0; i < n_; ++i) sum += w.f.row(i) * z(i);
-    return sum;
+  // Witness i without its drive term, row·z + c.
+  double witness_sum(std::size_t i, const SmallVector& z) const {
+    const WitnessRow& w = witness_rows_[i];
+    return n_ == 4 ? w.sum<4>(z) : n_ == 2 ? w.sum<2>(z) : w.sum<0>(z);
   }
 
   SmallVector z_at(double t) const {
     if (steps_.empty() || t <= steps_.front().t0) return sys_.z0;
-    auto it = std::upper_bound(steps_.begin(), steps_.end(), t, [](double x, const Step& s) { return x < s.t1; });
-    const Step& step = it == steps_.end() ? steps_.back() : *it;
+    const Step& step = steps_[std::min(step_after(t), steps_.size() - 1)];
     SmallVector z(n_);
     step.values(std::min(t, step.t1), n_, z);
     return z;
+  }
+
+  // The first step whose end is beyond t (steps_.size() if none): std::upper_bound on the ends,
+  // which never decrease, searched from the step found last (states are read in order of time).
+  std::size_t step_after(double t) const {
+    std::size_t k = std::min(step_cursor_, steps_.size());
+    while (k > 0 && t < steps_[k - 1].t1) --k;
+    while (k < steps_.size() && !(t < steps_[k].t1)) ++k;
+    step_cursor_ = k;
+    return k;
   }
 
   HybridState state_of(const SmallVector& z) const {
@@ -433,14 +497,12 @@ class DelayedSegment final : public Segment {
     return {measured(p_, start_) + z(i), z1(i), z2(i)};
   }
 
-  // Whether each witness is armed at the start (valid side), exits at once, departs from its
-  // boundary inward with a non-zero rate (armed from its first positive sample: a tiny
-  // bounce's return is an event however small), or waits until it is clearly inside.
-  enum class Arming { Armed, ExitNow, Departing, Waiting };
-  Arming arm(const Witness& w, double& tolerance_out) const {
+  // Arms a witness at the segment's start (Arming).
+  Arming arm(std::size_t i, double& tolerance_out) const {
+    const Witness& w = witnesses_[i];
     const auto [z1, z2] = derivatives(sys_.z0, t0_);
     const Jet d = line_.drive(t0_);
-    const double w0 = witness_value(w, sys_.z0, t0_);
+    const double w0 = witness_value(i, sys_.z0, t0_);
     const double w1 = w.f.row.dot(z1) + w.f.drive_weight * d.rate;
     // On the boundary: within the rounding of its terms, or what the previous event's time
     // tolerance moves it (as the closed-form engine, effects_simulation.cpp).
@@ -482,9 +544,10 @@ class DelayedSegment final : public Segment {
   // Everything stuck: only the delayed drive moves; the history stays at the current θo.
   void hold_still(double stop) {
     const double quiet = line_.last_motion() + e_.delay;
-    std::vector<double> tolerances(witnesses_.size());
+    std::vector<double>& tolerances = buffers_.tolerances;
+    tolerances.resize(witnesses_.size());
     for (std::size_t i = 0; i < witnesses_.size(); ++i) {
-      if (arm(witnesses_[i], tolerances[i]) == Arming::ExitNow) {
+      if (arm(i, tolerances[i]) == Arming::ExitNow) {
         exit = Exit{0, witnesses_[i], false};
         return;
       }
@@ -494,8 +557,9 @@ class DelayedSegment final : public Segment {
     double a = t0_;
     for (int k = 1; k <= samples && until > t0_; ++k) {
       const double b = t0_ + (until - t0_) * k / samples;
-      for (const Witness& w : witnesses_) {
-        auto f = [&](double t) { return witness_value(w, sys_.z0, t); };
+      for (std::size_t i = 0; i < witnesses_.size(); ++i) {
+        const Witness& w = witnesses_[i];
+        auto f = [&](double t) { return witness_value(i, sys_.z0, t); };
         const double fa = f(a), fb = f(b);
         if (fa >= 0 && fb < 0) {
           std::uintmax_t iterations = 100;
@@ -517,16 +581,18 @@ class DelayedSegment final : public Segment {
   // Returns where the segment ends: `stop`, an exit, or the end of its last kept step.
   double integrate(double stop) {
     const double dt_max = std::min(e_.delay, 0.1 / fastest_mode_rate(p_, e_));
-    std::vector<Arming> arming(witnesses_.size());
-    std::vector<double> tolerances(witnesses_.size());
+    std::vector<Arming>& arming = buffers_.arming;
+    std::vector<double>& tolerances = buffers_.tolerances;
+    arming.resize(witnesses_.size());
+    tolerances.resize(witnesses_.size());
     for (std::size_t i = 0; i < witnesses_.size(); ++i) {
-      arming[i] = arm(witnesses_[i], tolerances[i]);
+      arming[i] = arm(i, tolerances[i]);
       if (arming[i] == Arming::ExitNow) {
         exit = Exit{0, witnesses_[i], false};
         return stop;
       }
     }
-    const FlatSystem flat(sys_);
+    const FlatSystem& flat = flat_;
     auto rhs = [this, &flat](const Vector& x, Vector& dx, double t) {
       const double drive = line_.drive_value(t);
       if (flat.n == 4) flat.apply<4>(x, dx, drive);
@@ -608,26 +674,28 @@ class DelayedSegment final : public Segment {
     // (DelayLine::locate's cursor: the same reads in the same order, the same bits).
     double drive = 0;
     bool drive_read = false;
-    auto value = [&](const Witness& w, const SmallVector& z, double t) {
-      const double sum = witness_sum(w, z);
-      if (w.f.drive_weight == 0) return sum;
+    auto value = [&](std::size_t i, const SmallVector& z, double t) {
+      const double sum = witness_sum(i, z);
+      const double k = witness_rows_[i].drive_weight;
+      if (k == 0) return sum;
       if (!drive_read) drive = line_.drive_value(t), drive_read = true;
-      return sum + w.f.drive_weight * drive;
+      return sum + k * drive;
     };
     double a = step.t0;
     std::vector<double>& wa = witness_buffer_;
+    const std::size_t count = witnesses_.size();
     const SmallVector z_a = z_of(a);
-    for (std::size_t i = 0; i < witnesses_.size(); ++i) wa[i] = value(witnesses_[i], z_a, a);
+    for (std::size_t i = 0; i < count; ++i) wa[i] = value(i, z_a, a);
     std::optional<Exit> first;  // empty at every sample: the first exit ends the search
     for (int k = 1; k <= samples_per_step; ++k) {
       const double b = k == samples_per_step ? step.t1 : step.t0 + (step.t1 - step.t0) * k / samples_per_step;
       const SmallVector zb = z_of(b);
       drive_read = false;
-      for (std::size_t i = 0; i < witnesses_.size(); ++i) {
+      for (std::size_t i = 0; i < count; ++i) {
         const Witness& w = witnesses_[i];
-        const double wb = value(w, zb, b);
+        const double wb = value(i, zb, b);
         if (arming[i] == Arming::Armed && wa[i] >= 0 && wb < 0) {
-          auto f = [&](double t) { return witness_value(w, z_of(t), t); };
+          auto f = [&](double t) { return witness_value(i, z_of(t), t); };
           std::uintmax_t iterations = 100;
           const auto r = boost::math::tools::toms748_solve(f, a, b, wa[i], wb,
                                                            boost::math::tools::eps_tolerance<double>(50), iterations);
@@ -670,11 +738,15 @@ class DelayedSegment final : public Segment {
   DelayLine& line_;
   double rest_velocity_;
   ModeSystem sys_;
+  FlatSystem flat_;  // sys_ on fixed arrays
   int n_ = 4;
   ModeFunctionals functionals_;
-  std::vector<Witness> witnesses_;
-  std::vector<double> witness_buffer_;  // check_step's witness values at the sample before
-  std::vector<Step> steps_;
+  SegmentBuffers buffers_;  // line_'s, given back at the end
+  std::vector<Witness>& witnesses_ = buffers_.witnesses;
+  std::vector<WitnessRow>& witness_rows_ = buffers_.witness_rows;
+  std::vector<double>& witness_buffer_ = buffers_.witness_values;
+  std::vector<Step>& steps_ = buffers_.steps;
+  mutable std::size_t step_cursor_ = 0;  // step_after's last answer
 };
 
 class DelayedEngine final : public Engine {
