@@ -170,6 +170,10 @@ WitnessMode witness_mode(const SmallMatrix& A, const SmallVector& c, const Small
 /// The same without the copy: the kept entry itself, its forcing set to c — valid until the next
 /// call on this thread (copy it to keep it).
 const WitnessMode& kept_witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e);
+/// The same for the witnesses of one matrix A: `group` = kept_mode_group(A) (A's value among
+/// the kept entries, so A is compared once for all of a segment's witnesses, not once each).
+std::uint64_t kept_mode_group(const SmallMatrix& A);
+const WitnessMode& kept_witness_mode(std::uint64_t group, const SmallMatrix& A, const SmallVector& c, const SmallRow& e);
 
 /// Whether the gap rate θ̇L − θ̇m of a free flight in mode `m` of the closed-form engine (rigid
 /// gear: no compliance, delay or Stribeck friction) has at most two real zeros, counted with

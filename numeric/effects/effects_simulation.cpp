@@ -161,30 +161,93 @@ bool spurious_separation(const Parameters& p, const ModeFlow& flow, double tau) 
 // for (A, e) is given the forcing c and returned as it is.  The least recently used entry is the
 // one replaced, so an entry stays where it is (and keeps its forcing) for the next capacity − 1
 // calls on this thread: a segment's searches (a few witnesses) hold their entries by reference.
-const WitnessMode& detail::kept_witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e) {
-  constexpr std::size_t capacity = 32;
+// A segment's witnesses share A: A is compared once per segment (kept_mode_group), each entry
+// carrying the group of its A's value, and a witness's entry is found by its group and e.
+namespace {
+
+// x == y element by element (exact, as Eigen's ==: +0 == −0, a NaN equals nothing): for the
+// modes' sizes (4 × 4, 2 × 2 and their rows) every element compared without a branch (vector
+// compares), otherwise stopping at the first difference.
+template <int N>
+bool same_values_of(const double* x, const double* y) {
+  bool same = true;
+  for (int i = 0; i < N; ++i) same &= x[i] == y[i];
+  return same;
+}
+bool same_values(const double* x, const double* y, Eigen::Index n) {
+  if (n == 16) return same_values_of<16>(x, y);
+  if (n == 4) return same_values_of<4>(x, y);
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (!(x[i] == y[i])) return false;
+  return true;
+}
+
+struct KeptModes {
+  static constexpr std::size_t capacity = 32;
   struct Entry {
     WitnessMode mode;
     std::uint64_t used;
+    std::uint64_t group;  // every entry of a group has the same A (==); groups are never reused
   };
-  thread_local std::vector<Entry> cache = [] {
-    std::vector<Entry> v;
-    v.reserve(capacity);
-    return v;
-  }();
-  thread_local std::uint64_t clock = 0;
-  ++clock;
-  const auto same = [](const auto& x, const auto& y) { return x.rows() == y.rows() && x.cols() == y.cols() && x == y; };
-  for (Entry& entry : cache) {
-    if (!same(entry.mode.e, e) || !same(entry.mode.A, A)) continue;
-    entry.mode.set_forcing(c);
-    entry.used = clock;
-    return entry.mode;
+  KeptModes() { entries.reserve(capacity); }
+  std::vector<Entry> entries;
+  std::uint64_t clock = 0, groups = 0;
+  std::size_t last = 0;  // the entry found or made by the last call
+};
+
+KeptModes& kept_modes() {
+  thread_local KeptModes kept;
+  return kept;
+}
+
+}  // namespace
+
+std::uint64_t detail::kept_mode_group(const SmallMatrix& A) {
+  KeptModes& kept = kept_modes();
+  std::uint64_t other = 0;  // a group whose A is not A (no group is 0): a group's entries are mostly made together
+  for (const KeptModes::Entry& entry : kept.entries) {
+    if (entry.group == other) continue;
+    if (entry.mode.A.rows() == A.rows() && entry.mode.A.cols() == A.cols() &&
+        same_values(entry.mode.A.data(), A.data(), A.size()))
+      return entry.group;
+    other = entry.group;
   }
-  if (cache.size() < capacity) return cache.push_back({WitnessMode(A, c, e), clock}), cache.back().mode;
-  Entry& oldest = *std::min_element(cache.begin(), cache.end(), [](const Entry& a, const Entry& b) { return a.used < b.used; });
-  oldest = {WitnessMode(A, c, e), clock};
-  return oldest.mode;
+  return ++kept.groups;  // A's value is in no entry: a new group
+}
+
+const WitnessMode& detail::kept_witness_mode(std::uint64_t group, const SmallMatrix& A, const SmallVector& c,
+                                             const SmallRow& e) {
+  KeptModes& kept = kept_modes();
+  std::vector<KeptModes::Entry>& cache = kept.entries;
+  ++kept.clock;
+  const auto same = [&](const KeptModes::Entry& entry) {
+    return entry.group == group && entry.mode.e.size() == e.size() && same_values(entry.mode.e.data(), e.data(), e.size());
+  };
+  const auto found = [&](std::size_t i) -> const WitnessMode& {
+    cache[i].mode.set_forcing(c);
+    cache[i].used = kept.clock;
+    kept.last = i;
+    return cache[i].mode;
+  };
+  // At most one entry matches (one is made only when none does), so the order the entries are
+  // tried in does not change the answer: the one after the last found first (a mode's witnesses
+  // come in the same order each time it is entered, and their entries were made in that order).
+  if (kept.last + 1 < cache.size() && same(cache[kept.last + 1])) return found(kept.last + 1);
+  for (std::size_t i = 0; i < cache.size(); ++i)
+    if (same(cache[i])) return found(i);
+  if (cache.size() < KeptModes::capacity) {
+    cache.push_back({WitnessMode(A, c, e), kept.clock, group});
+    kept.last = cache.size() - 1;
+    return cache.back().mode;
+  }
+  const auto oldest = std::min_element(cache.begin(), cache.end(), [](const auto& a, const auto& b) { return a.used < b.used; });
+  *oldest = {WitnessMode(A, c, e), kept.clock, group};
+  kept.last = static_cast<std::size_t>(oldest - cache.begin());
+  return oldest->mode;
+}
+
+const WitnessMode& detail::kept_witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e) {
+  return kept_witness_mode(kept_mode_group(A), A, c, e);
 }
 
 WitnessMode detail::witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e) {
@@ -228,7 +291,7 @@ class SampleMemo {
 class ExitSearch {
  public:
   ExitSearch(const Parameters& p, const ModeFlow& flow, const SampleMemo& memo, const SmallVector& zdot,
-             const Witness& witness, double horizon, double t_global)
+             std::uint64_t group, const Witness& witness, double horizon, double t_global)
       : p_(p), flow_(flow), memo_(memo), witness_(witness) {
     level_ = -witness.f.constant;
     // The search on a mode built once (kept per thread: its entry stays put while this segment's
@@ -236,7 +299,7 @@ class ExitSearch {
     // as without one: the search's constants are WitnessMode(A, c, e) either way, so they are not
     // built again for each window of each witness (issue 19: the mesh's searches).
     bound_ = flow.derivative_bound(witness.f.row, 3);
-    mode_ = &detail::kept_witness_mode(flow.segment().A, flow.segment().c, witness.f.row);
+    mode_ = &detail::kept_witness_mode(group, flow.segment().A, flow.segment().c, witness.f.row);
     const Start start = classify_start(flow, *mode_, level_, zdot, witness.f.magnitude, horizon, t_global);
     if (start.kind == StartKind::Never) finished_ = true;
     if (start.kind == StartKind::ExitNow) immediate_ = true;
@@ -368,8 +431,9 @@ class ClosedFormSegment final : public detail::Segment {
     const SampleMemo memo(flow_);
     const SmallVector zdot = flow_.segment().A * flow_.local_start() + flow_.segment().c;  // ż(0)
     searches.reserve(witnesses.size());
+    const std::uint64_t group = detail::kept_mode_group(flow_.segment().A);  // the witnesses' A, compared once
     for (const Witness& w : witnesses) {
-      searches.emplace_back(p, flow_, memo, zdot, w, horizon, t_global);
+      searches.emplace_back(p, flow_, memo, zdot, group, w, horizon, t_global);
       if (searches.back().immediate()) {
         duration = 0;
         if (w.guard != Guard::Handover) exit = Exit{0, w, false};  // a handover at once: an empty segment

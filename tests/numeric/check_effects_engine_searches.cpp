@@ -9,6 +9,11 @@
 //                                 the cache replaces its least recently used entry, so an entry used
 //                                 again is not the next one overwritten (main's round robin replaced
 //                                 it), and it stays bit for bit WitnessMode(A, c, e);
+//   check_kept_constants_by_group
+//                                 a segment's witnesses found by A's group (kept_mode_group) get the
+//                                 constants of their own A and e, bit for bit, with matrices that differ
+//                                 in one element only (each of the 16), segments interleaved at random
+//                                 and more entries than the cache holds;
 //   free_kernels_as_coupled       a free flight's kernels of one node (phi_pair) are coupled_kernels'
 //                                 own, bit for bit;
 //   check_conditioning_decided_as_by_the_moduli
@@ -135,6 +140,42 @@ TEST(EffectsEngineSearches, item_effects_kept_constants_stay_put) {
     EXPECT_TRUE(used->A == matrices[0] && used->e == e) << "the entry in use was replaced";
     EXPECT_TRUE(same_bits(used->mu_A, rebuilt.mu_A) && same_bits(used->norm_eA2, rebuilt.norm_eA2) &&
                 same_bits(used->eA2c, rebuilt.eA2c));
+  }).join();
+}
+
+TEST(EffectsEngineSearches, check_kept_constants_by_group) {
+  using numeric::SmallMatrix;
+  using numeric::SmallRow;
+  using numeric::SmallVector;
+  std::thread([] {
+    std::mt19937 random(23);
+    std::uniform_real_distribution<double> entry(-2, 2);
+    SmallMatrix base(4, 4);
+    for (int i = 0; i < 16; ++i) base.data()[i] = entry(random);
+    std::vector<SmallMatrix> matrices{base};
+    for (int i = 0; i < 16; ++i) {  // each differs from base in element i alone
+      matrices.push_back(base);
+      matrices.back().data()[i] += 0.5;
+    }
+    std::vector<SmallRow> rows(3, SmallRow(4));
+    rows[0] << 1, 0, -1, 0;
+    rows[1] << 0, 1, 0, -1;
+    rows[2] << 0, 1, 0, 0;
+    std::uniform_int_distribution<std::size_t> pick(0, matrices.size() - 1);
+    for (int segment = 0; segment < 400; ++segment) {
+      const SmallMatrix& A = matrices[pick(random)];
+      SmallVector c(4);
+      for (int i = 0; i < 4; ++i) c(i) = entry(random);
+      const std::uint64_t group = numeric::detail::kept_mode_group(A);
+      for (std::size_t k = segment % 2 == 0 ? 0 : 1; k < rows.size(); ++k) {
+        const numeric::WitnessMode& kept = numeric::detail::kept_witness_mode(group, A, c, rows[k]);
+        const numeric::WitnessMode rebuilt(A, c, rows[k]);
+        ASSERT_TRUE(kept.A == A && kept.e == rows[k]) << "segment " << segment << " witness " << k;
+        ASSERT_TRUE(same_bits(kept.mu_A, rebuilt.mu_A) && same_bits(kept.norm_eA3, rebuilt.norm_eA3) &&
+                    same_bits(kept.eAc, rebuilt.eAc) && same_bits(kept.ec, rebuilt.ec))
+            << "segment " << segment << " witness " << k;
+      }
+    }
   }).join();
 }
 
