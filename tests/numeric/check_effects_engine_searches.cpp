@@ -4,6 +4,11 @@
 //                                 a mesh mode's flow (its kept eigen-decomposition) is the
 //                                 augmented matrix's exponential e^{Mτ} z̃0 (Eigen's Padé) within
 //                                 1e-12 of the state's scale, on mesh modes from random starts;
+//   check_matrix_exponential_flow_as_dynamic
+//                                 a mesh flow by the matrix exponential (a body stuck: the augmented
+//                                 matrix is defective) is e^{Mτ} z̃0 formed on Eigen::MatrixXd bit for
+//                                 bit (the flow holds M in a heap-free matrix of at most 5×5), from
+//                                 random starts and times;
 //   item_effects_kept_constants_stay_put
 //                                 a kept witness's constants stay where they are while they are in use:
 //                                 the cache replaces its least recently used entry, so an entry used
@@ -111,6 +116,43 @@ TEST(EffectsEngineSearches, compliance_flow_is_the_augmented_exponential) {
     }
   });
   EXPECT_GT(checked, 0);
+}
+
+TEST(EffectsEngineSearches, check_matrix_exponential_flow_as_dynamic) {
+  const numeric::Parameters p = numeric::parameters_of(model::load_case("V"));
+  const numeric::Effects e = compliance();
+  std::mt19937 random(33);
+  std::uniform_real_distribution<double> unit(-1, 1);
+  int checked = 0;
+  for (int face : {-1, 1})
+    for (auto [sm, sl] : {std::pair{0, 1}, std::pair{1, 0}, std::pair{0, -1}, std::pair{-1, 0}})
+      for (int trial = 0; trial < 5; ++trial) {
+        const numeric::Mode m{numeric::ModeKind::Mesh, face, 0, sm, sl};
+        numeric::HybridState start;
+        start.in_contact = true;
+        start.face = face;
+        start.theta_m = 0.6 + 0.3 * unit(random);
+        start.theta_L = start.theta_m + face * (p.backlash / 2 + 1e-3 * std::fabs(unit(random)));
+        start.dtheta_m = sm == 0 ? 0 : unit(random);
+        start.dtheta_L = sl == 0 ? 0 : unit(random);
+        const numeric::ModeFlow flow(p, e, m, start);
+        ASSERT_TRUE(flow.uses_matrix_exponential()) << m.describe();
+        const int n = static_cast<int>(flow.segment().A.rows());
+        Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n + 1, n + 1);
+        M.topLeftCorner(n, n) = flow.segment().A;
+        M.block(0, n, n, 1) = flow.segment().c;
+        Eigen::Matrix<double, 5, 1> z0 = Eigen::Matrix<double, 5, 1>::Zero();
+        z0.head(n) = flow.local_start();
+        z0(n) = 1;
+        for (double tau : {1e-3 * std::fabs(unit(random)), 0.3 * std::fabs(unit(random)), 20 * std::fabs(unit(random))}) {
+          const Eigen::MatrixXd E = (M * tau).exp();
+          const numeric::SmallVector reference((E * z0.head(n + 1)).head(n));
+          const numeric::SmallVector z = flow.local(tau);
+          for (int i = 0; i < n; ++i) EXPECT_TRUE(same_bits(z(i), reference(i))) << m.describe() << ", tau " << tau;
+          ++checked;
+        }
+      }
+  EXPECT_EQ(checked, 2 * 4 * 5 * 3);
 }
 
 TEST(EffectsEngineSearches, item_effects_kept_constants_stay_put) {
