@@ -433,7 +433,7 @@ CoupledKernels ModeFlow::node_kernels(double x, double y, bool motor, bool load)
   return k;
 }
 
-void ModeFlow::load_part(double tau, const CoupledKernels& k, double& z2, double& z3) const {
+[[gnu::always_inline]] inline void ModeFlow::load_part(double tau, const CoupledKernels& k, double& z2, double& z3) const {
   const double vL0 = z0_(3), t2 = tau * tau;
   if (mode_.slip_load == 0) {
     z2 = 0;
@@ -444,7 +444,7 @@ void ModeFlow::load_part(double tau, const CoupledKernels& k, double& z2, double
   }
 }
 
-void ModeFlow::motor_part(double tau, const CoupledKernels& k, double& z0, double& z1) const {
+[[gnu::always_inline]] inline void ModeFlow::motor_part(double tau, const CoupledKernels& k, double& z0, double& z1) const {
   const double vm0 = z0_(1), vL0 = z0_(3), t2 = tau * tau;
   switch (motor_form_) {
     case 0:
