@@ -396,10 +396,10 @@ bool one_turn_applies(detail::OneTurn one_turn, const Parameters& p, const Effec
   for (double a = 0; a < horizon && !exit; a += window, window *= 2) {
     const double b = std::min(horizon, a + window);
     exit = searches[0].search_until(b);
-    if (!exit && searches[1].rising_at(b))
-      searches[1].pass_until(b);
-    else if (!exit)
-      exit = searches[1].search_until(b);
+    if (!exit) {
+      if (searches[1].rising_at(b)) searches[1].pass_until(b);
+      else exit = searches[1].search_until(b);
+    }
     for (std::size_t i = 2; i < searches.size(); ++i) {
       const std::optional<Exit> candidate = searches[i].search_until(exit ? exit->tau : b);
       if (candidate && (!exit || candidate->tau < exit->tau)) exit = candidate;

@@ -244,13 +244,12 @@ class TrajectoryRecorder {
 
  private:
   void push(double t, double theta_o) {  // SimulationOptions::sample_theta_o_only
-    const TrajectorySample sample{t, theta_o, NAN, NAN, NAN, NAN, NAN, false};
-    if (o_.sample_sink) o_.sample_sink(sample);
-    else r_.samples.push_back(sample);
+    emit({t, theta_o, NAN, NAN, NAN, NAN, NAN, false});
   }
   void push(double t, const HybridState& h) {
-    const TrajectorySample sample{t, measured(p_, h), measured_velocity(p_, h), h.theta_m, h.dtheta_m, h.theta_L,
-                                  h.dtheta_L, h.in_contact};
+    emit({t, measured(p_, h), measured_velocity(p_, h), h.theta_m, h.dtheta_m, h.theta_L, h.dtheta_L, h.in_contact});
+  }
+  void emit(const TrajectorySample& sample) {
     if (o_.sample_sink) o_.sample_sink(sample);
     else r_.samples.push_back(sample);
   }
