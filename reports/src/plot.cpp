@@ -3,6 +3,7 @@
 #include "backlash/output/text.hpp"
 #include "backlash/symbolic/escape.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdint>
@@ -10,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <sstream>
 
 #include <stdlib.h>  // mkdtemp (POSIX)
@@ -58,31 +60,44 @@ void fix_pdf_dates(const std::filesystem::path& file) {
   io.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
-// gnuplot splits enhanced text into <tspan>s ("θ_{m} and" gives "θ", "m", " and"), and
+// True where `from` was found in `bytes` (every occurrence then replaced by `to`).
+bool replace_all(std::string& bytes, const std::string& from, const std::string& to) {
+  std::string edited;
+  std::size_t start = 0;
+  for (std::size_t at = bytes.find(from); at != std::string::npos; at = bytes.find(from, start)) {
+    if (edited.empty()) edited.reserve(bytes.size() + bytes.size() / 16);
+    edited.append(bytes, start, at - start).append(to);
+    start = at + from.size();
+  }
+  if (start == 0) return false;
+  edited.append(bytes, start, std::string::npos);
+  bytes = std::move(edited);
+  return true;
+}
+
+// Two edits of gnuplot's SVG, in one read and one write.
+// (1) gnuplot splits enhanced text into <tspan>s ("θ_{m} and" gives "θ", "m", " and"), and
 // librsvg (and other SVG renderers) collapse the space that starts a tspan, even a
 // no-break space, unless the text element preserves white space: "θmand".  Every
 // <text> gets xml:space="preserve" (gnuplot writes no white space between the tspans).
-void preserve_svg_spaces(const std::filesystem::path& file) {
+// (2) A heat map drawn as an image (one PNG pixel per cell) is scaled up by the viewer,
+// which blurs it unless told to keep the pixels sharp: every <image> gets image-rendering
+// (CSS `pixelated` in the style, the SVG 1.1 `optimizeSpeed` as attribute for viewers that
+// know only that; librsvg 2.54 ignores both and smooths).
+void edit_svg(const std::filesystem::path& file) {
   std::string bytes;
   {
     std::ifstream in(file, std::ios::binary);
     if (!in) return;
-    std::ostringstream all;  // in one read, not a character at a time (a map's SVG is a megabyte)
+    std::ostringstream all;  // in one read, not a character at a time (a map's SVG can be a megabyte)
     all << in.rdbuf();
     bytes = std::move(all).str();
   }
-  const std::string plain = "<text>", kept = "<text xml:space=\"preserve\">";
-  std::string edited;
-  std::size_t from = 0;
-  for (std::size_t at = bytes.find(plain); at != std::string::npos; at = bytes.find(plain, from)) {
-    if (edited.empty()) edited.reserve(bytes.size() + bytes.size() / 16);
-    edited.append(bytes, from, at - from).append(kept);
-    from = at + plain.size();
-  }
-  if (from == 0) return;  // nothing replaced
-  edited.append(bytes, from, std::string::npos);
+  const bool text = replace_all(bytes, "<text>", "<text xml:space=\"preserve\">");
+  const bool image = replace_all(bytes, "<image ", "<image style='image-rendering:pixelated' image-rendering='optimizeSpeed' ");
+  if (!text && !image) return;
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  out.write(edited.data(), static_cast<std::streamsize>(edited.size()));
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
 // "%.6g": the value written at a bar's end.
@@ -126,7 +141,7 @@ std::string figure_csv(const Plot& plot) {
 namespace {
 
 // The inline data blocks of figure f: $d<f>_<i> per series (a blank line where a point is
-// not finite: a break in the line) and $h<f> for the heat map (x y xlow xhigh ylow yhigh value).
+// not finite: a break in the line), $b<f> for the bars; $h<f> (the heat map) below.
 // number(v) for values seen before, by their bits: a direct-mapped table of texts (a heat map
 // writes each grid edge and centre once per cell).  A number's text depends on its bits alone.
 class NumberTexts {
@@ -166,12 +181,84 @@ void write_data_blocks(std::ostringstream& script, const Plot& plot, std::size_t
     }
     script << "EOD\n";
   }
-  if (!plot.heat_map) return;
+}
+
+// The heat map's cells as an image (HeatMap's rule in plot.hpp): the pixel of each cell in
+// gnuplot's scan order (x fastest, rows upwards), NaN where the grid has no cell or its value
+// is NaN (gnuplot leaves a NaN pixel transparent: blank, as a cell without a box).
+struct HeatImage {
+  std::size_t nx = 0, ny = 0;
+  double x0 = 0, dx = 0, y0 = 0, dy = 0;
+  std::vector<double> pixel;
+};
+
+// The column of each cell [low, high] on a uniform grid of at least 2 columns from min(low)
+// to max(high), within rounding (1e-6 of a column); the number of columns; nothing if the
+// cells do not form one.
+std::optional<std::pair<std::vector<std::size_t>, std::size_t>> uniform_columns(const std::vector<double>& low,
+                                                                                const std::vector<double>& high) {
+  if (low.empty()) return std::nullopt;
+  const double from = *std::min_element(low.begin(), low.end()), to = *std::max_element(high.begin(), high.end());
+  const double width = high[0] - low[0], columns = std::round((to - from) / width);
+  if (!std::isfinite(from) || !std::isfinite(to) || !(width > 0) || !(columns >= 2 && columns <= 1e6)) return std::nullopt;
+  const double step = (to - from) / columns, tolerance = 1e-6 * step;
+  std::vector<std::size_t> column(low.size());
+  for (std::size_t k = 0; k < low.size(); ++k) {
+    const double i = std::round((low[k] - from) / step);
+    if (!(std::abs(low[k] - (from + i * step)) <= tolerance && std::abs(high[k] - (from + (i + 1) * step)) <= tolerance))
+      return std::nullopt;
+    column[k] = static_cast<std::size_t>(i);
+  }
+  return std::pair{std::move(column), static_cast<std::size_t>(columns)};
+}
+
+std::optional<HeatImage> heat_image(const Plot& plot) {
+  if (!plot.heat_map || plot.x_log || plot.y_log) return std::nullopt;  // gnuplot draws images linearly only
+  const HeatMap& h = *plot.heat_map;
+  std::vector<double> x_low, x_high, y_low, y_high, value;  // the cells with a value
+  for (std::size_t k = 0; k < h.value.size() && k < h.x_low.size() && k < h.x_high.size() && k < h.y_low.size() && k < h.y_high.size(); ++k)
+    if (std::isfinite(h.value[k])) {
+      x_low.push_back(h.x_low[k]), x_high.push_back(h.x_high[k]), y_low.push_back(h.y_low[k]), y_high.push_back(h.y_high[k]);
+      value.push_back(h.value[k]);
+    }
+  const auto columns = uniform_columns(x_low, x_high), rows = uniform_columns(y_low, y_high);
+  if (!columns || !rows || columns->second * rows->second > 4 * value.size()) return std::nullopt;  // at most 4 pixels per cell
+  HeatImage image;
+  image.nx = columns->second, image.ny = rows->second;
+  image.x0 = *std::min_element(x_low.begin(), x_low.end());
+  image.dx = (*std::max_element(x_high.begin(), x_high.end()) - image.x0) / static_cast<double>(image.nx);
+  image.y0 = *std::min_element(y_low.begin(), y_low.end());
+  image.dy = (*std::max_element(y_high.begin(), y_high.end()) - image.y0) / static_cast<double>(image.ny);
+  image.pixel.assign(image.nx * image.ny, std::numeric_limits<double>::quiet_NaN());
+  for (std::size_t k = 0; k < value.size(); ++k) {
+    double& pixel = image.pixel[columns->first[k] + image.nx * rows->first[k]];
+    if (!std::isnan(pixel)) return std::nullopt;  // a cell twice
+    pixel = value[k];
+  }
+  return image;
+}
+
+// $h<f>: the heat map, as an image (x y value per pixel, NaN for a blank one) or as cells
+// (x y xlow xhigh ylow yhigh value; the cells with a value).  Returns true for an image.
+bool write_heat_map_block(std::ostringstream& script, const Plot& plot, std::size_t f) {
+  if (!plot.heat_map) return false;
   const HeatMap& h = *plot.heat_map;
   NumberTexts texts;  // a grid's cells repeat their edges and centres
   const auto number = [&texts](double v) -> const std::string& { return texts.of(v); };
   script << "$h" << f << " << EOD\n";
-  for (std::size_t k = 0; k < h.value.size() && k < h.x_low.size() && k < h.x_high.size() && k < h.y_low.size() && k < h.y_high.size(); ++k) {
+  const std::optional<HeatImage> image = heat_image(plot);
+  if (image) {
+    for (std::size_t j = 0; j < image->ny; ++j) {
+      const std::string y = number(image->y0 + (static_cast<double>(j) + 0.5) * image->dy);
+      for (std::size_t i = 0; i < image->nx; ++i) {
+        const double v = image->pixel[i + image->nx * j];
+        script << number(image->x0 + (static_cast<double>(i) + 0.5) * image->dx) << " " << y << " ";
+        if (std::isnan(v)) script << "NaN\n";
+        else script << number(v) << "\n";
+      }
+    }
+  }
+  for (std::size_t k = 0; !image && k < h.value.size() && k < h.x_low.size() && k < h.x_high.size() && k < h.y_low.size() && k < h.y_high.size(); ++k) {
     if (!std::isfinite(h.value[k])) continue;
     const double xc = plot.x_log ? std::sqrt(h.x_low[k] * h.x_high[k]) : (h.x_low[k] + h.x_high[k]) / 2;
     const double yc = plot.y_log ? std::sqrt(h.y_low[k] * h.y_high[k]) : (h.y_low[k] + h.y_high[k]) / 2;
@@ -179,6 +266,7 @@ void write_data_blocks(std::ostringstream& script, const Plot& plot, std::size_t
            << number(h.y_low[k]) << " " << number(h.y_high[k]) << " " << number(h.value[k]) << "\n";
   }
   script << "EOD\n";
+  return image.has_value();
 }
 
 // The settings a heat map and log axes add (none for a plain plot: its script is unchanged).
@@ -218,7 +306,7 @@ void write_shade_and_bar_settings(std::ostringstream& body, const Plot& plot) {
 }
 
 // The gnuplot commands that draw figure f (the same for the SVG and the PDF).
-std::string figure_body(const Plot& plot, std::size_t f) {
+std::string figure_body(const Plot& plot, std::size_t f, bool heat_image) {
   std::ostringstream body;
   body << "reset\nset encoding utf8\n"
        << "set title " << quoted(plot.title) << "\n"
@@ -233,9 +321,9 @@ std::string figure_body(const Plot& plot, std::size_t f) {
     body << "set label " << (l + 1) << " " << quoted(plot.labels[l].text) << " at " << number(plot.labels[l].x) << ","
          << number(plot.labels[l].y) << " font ',9' tc rgb '#555555'\n";
   body << "plot ";
-  if (plot.heat_map)
-    body << "$h" << f << " using 1:2:3:4:5:6:7 with boxxyerror fs solid 1.0 noborder lc palette notitle"
-         << (plot.series.empty() && !(plot.bars && !plot.bars->values.empty()) ? "" : ", \\\n     ");
+  if (plot.heat_map && heat_image) body << "$h" << f << " using 1:2:3 with image notitle";
+  else if (plot.heat_map) body << "$h" << f << " using 1:2:3:4:5:6:7 with boxxyerror fs solid 1.0 noborder lc palette notitle";
+  if (plot.heat_map) body << (plot.series.empty() && !(plot.bars && !plot.bars->values.empty()) ? "" : ", \\\n     ");
   if (plot.bars && !plot.bars->values.empty())
     body << "$b" << f << " using 1:2:3:4:5:6 with boxxyerror fs solid 1.0 noborder lc rgb " << quoted(plot.bars->colour, true)
          << " notitle" << (plot.series.empty() ? "" : ", \\\n     ");
@@ -258,7 +346,8 @@ std::optional<std::string> run_gnuplot(const std::vector<Plot>& plots, const std
   for (std::size_t f = 0; f < plots.size(); ++f) {
     const Plot& plot = plots[f];
     write_data_blocks(script, plot, f);
-    const std::string body = figure_body(plot, f);
+    const bool heat_image = write_heat_map_block(script, plot, f);
+    const std::string body = figure_body(plot, f, heat_image);
     const fs::path stem = fs::path("figures") / plot.name;
     script << "set terminal svg size " << plot.width << "," << plot.height << " enhanced font 'DejaVu Sans,12' background '#ffffff'\n"
            << "set output " << quoted(stem.string() + ".svg", true) << "\n"
@@ -293,7 +382,7 @@ std::optional<std::string> run_gnuplot(const std::vector<Plot>& plots, const std
   if (!failure)
     for (const Plot& plot : plots) {
       if (pdf) fix_pdf_dates(directory / "figures" / (plot.name + ".pdf"));
-      preserve_svg_spaces(directory / "figures" / (plot.name + ".svg"));
+      edit_svg(directory / "figures" / (plot.name + ".svg"));
     }
   return failure;
 }

@@ -1,10 +1,10 @@
 // What MapFigures::write leaves in a folder, for a synthetic three-parameter grid map with
 // a disk-shaped cycle region in (JL_over_Jm, FL_over_F) and exact boundary crossings:
-// a figure per pair (SVG with the data drawn, labelled axes with units, a colour-bar title,
-// a legend, the case named; a PDF), summary.md (counts per status, magnitude range, the
-// ranking, the figures linked), the same bytes from two writes; without gnuplot the summary
-// says why; bad input is refused with one line naming the point and the parameter; the
-// boundary markers stay bounded however many crossings come.
+// a figure per pair (SVG with the data drawn: boxes on a log axis, an image on linear ones;
+// labelled axes with units, a colour-bar title, a legend, the case named; a PDF), summary.md
+// (counts per status, magnitude range, the ranking, the figures linked), the same bytes from
+// two writes; without gnuplot the summary says why; bad input is refused with one line naming
+// the point and the parameter; the boundary markers stay bounded however many crossings come.
 #include "synthetic.hpp"
 
 #include <gtest/gtest.h>
@@ -99,8 +99,14 @@ TEST(MapFiguresFiles, EveryPairHasAFigureWithDataLabelsAndALegend) {
     EXPECT_NE(text.find("Case V: limit cycles over ("), std::string::npos) << stem << ": no title naming the case in: " << text;
     EXPECT_NE(text.find("mean peak-to-peak swing (rad) of θo, 0 without a cycle"), std::string::npos) << stem << ": no colour-bar title in: " << text;
     EXPECT_NE(text.find("half of the bin's points have a cycle"), std::string::npos) << stem << ": no legend entry for the boundary";
-    // the heat map: one filled box per bin (gnuplot draws each as a path with a fill colour)
-    EXPECT_GT(count(svg, "fill = 'rgb("), 40u) << stem << ": " << count(svg, "fill = 'rgb(") << " filled shapes";
+    // the heat map: with JL/Jm on a log axis one filled box per bin (gnuplot draws each as a
+    // path with a fill colour); FL/F × K, both linear, a uniform grid: one image, a pixel per bin
+    if (stem == std::string("map_FL_over_F_K")) {
+      EXPECT_EQ(count(svg, "<image "), 1u) << stem << ": the heat map is not one image";
+    } else {
+      EXPECT_EQ(count(svg, "<image "), 0u) << stem << ": a log axis drawn as an image";
+      EXPECT_GT(count(svg, "fill = 'rgb("), 40u) << stem << ": " << count(svg, "fill = 'rgb(") << " filled shapes";
+    }
   }
   const std::string text = visible_text(read(dir / "figures" / "map_JL_over_Jm_FL_over_F.svg"));
   EXPECT_NE(text.find("JL/Jm, inertia ratio, (Jm+JL) kept (dimensionless)"), std::string::npos) << text;

@@ -42,6 +42,16 @@ struct Label {
 /// A heat map drawn under the series: one filled cell [x_low, x_high] × [y_low, y_high]
 /// per entry, coloured by `value` (a NaN value leaves its cell blank), with a colour bar
 /// titled `colour_label` (with units).  The cells need not be uniform (log axes).
+///
+/// How it is drawn: as an image (gnuplot's `with image`, one pixel per cell: a PNG in the
+/// SVG, drawn with sharp pixels, an uninterpolated image in the PDF — a small fraction of
+/// the time and bytes of a box per cell) where that is exact: both axes linear, and the
+/// cells with a value form a uniform grid of at least 2 × 2 cells from their smallest low
+/// to their largest high edge (every edge within 1e-6 of a cell of the grid's), no cell
+/// twice, the cells with a value at least a quarter of the grid (a grid position without
+/// one is a transparent pixel: blank, as a cell without a box).  Otherwise one filled box
+/// per cell with a value (gnuplot's `boxxyerror`): non-uniform cells, log axes (gnuplot
+/// places an image's pixels linearly), a single row or column, a sparse grid.
 struct HeatMap {
   std::vector<double> x_low, x_high, y_low, y_high, value;
   std::string colour_label;
