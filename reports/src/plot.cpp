@@ -205,7 +205,8 @@ std::optional<std::pair<std::vector<std::size_t>, std::size_t>> uniform_columns(
   std::vector<std::size_t> column(low.size());
   for (std::size_t k = 0; k < low.size(); ++k) {
     const double i = std::round((low[k] - from) / step);
-    if (!(std::abs(low[k] - (from + i * step)) <= tolerance && std::abs(high[k] - (from + (i + 1) * step)) <= tolerance))
+    if (!(std::abs(low[k] - (from + i * step)) <= tolerance && std::abs(high[k] - (from + (i + 1) * step)) <= tolerance) ||
+        !(i >= 0 && i < columns))
       return std::nullopt;
     column[k] = static_cast<std::size_t>(i);
   }
