@@ -61,7 +61,7 @@ std::shared_ptr<const Simulator::Kept> Simulator::recall(const std::string& key)
 
 Simulator::Held Simulator::hold(const ModelPoint& m, std::size_t samples, Grid grid) {
   samples = std::min(samples, data_.size());
-  if (rows(samples, grid).size() == samples) grid = Grid::all;  // as traces() keeps it
+  if (row_count(samples, grid) == samples) grid = Grid::all;  // as traces() keeps it
   std::lock_guard<std::mutex> lock(cache_mutex_);
   std::erase_if(held_, [](const auto& entry) { return entry.second.expired(); });
   for (const std::string& key : {key_of(m, samples, Grid::all), key_of(m, samples, grid)})
@@ -97,15 +97,20 @@ std::vector<std::size_t> Simulator::rows(std::size_t samples, Grid grid) const {
   return out;
 }
 
+std::size_t Simulator::row_count(std::size_t samples, Grid grid) const {
+  if (grid == Grid::all) return samples;
+  const std::vector<std::size_t>& fitted = data_.fit_indices;
+  return static_cast<std::size_t>(std::lower_bound(fitted.begin(), fitted.end(), samples - 1) - fitted.begin()) + 1;
+}
+
 // A model point simulated before at this length is not simulated again (a fit's bracket, a
 // refit from the same point, a candidate judged after its fit): its work is charged all the same,
 // so the budget — a count — does not depend on which thread simulated it first.  A fit's request
 // (Grid::fitted) is served by a simulation of the whole grid as well.
 Simulator::Traces Simulator::traces(const ModelPoint& m, std::size_t samples, std::vector<numeric::SimulationEvent>* events,
-                                    long* cost, Grid grid) {
+                                    long* cost, Grid grid, std::size_t* event_count) {
   samples = std::min(samples, data_.size());
-  const std::vector<std::size_t> sampled = rows(samples, grid);
-  if (sampled.size() == samples) grid = Grid::all;
+  if (row_count(samples, grid) == samples) grid = Grid::all;
   std::shared_ptr<const Kept> kept = recall(key_of(m, samples, Grid::all));
   if (!kept && grid == Grid::fitted) kept = recall(key_of(m, samples, grid));
   if (kept) {
@@ -113,11 +118,12 @@ Simulator::Traces Simulator::traces(const ModelPoint& m, std::size_t samples, st
     work_ += kept->cost;
   } else {
     auto fresh = std::make_shared<Kept>();
-    fresh->traces = simulate(m, samples, sampled, &fresh->events, &fresh->cost);
+    fresh->traces = simulate(m, samples, rows(samples, grid), &fresh->events, &fresh->cost);
     if (fresh->cost > 0) keep(key_of(m, samples, grid), fresh);
     kept = std::move(fresh);
   }
   if (events) *events = kept->events;
+  if (event_count) *event_count = kept->events.size();
   if (cost) *cost = kept->cost;
   return kept->traces;
 }
@@ -146,8 +152,15 @@ Simulator::Traces Simulator::simulate(const ModelPoint& m, std::size_t samples, 
         (*out)[c][rows[filled]] = data_.which[c] == 0 ? s.theta_o : data_.which[c] == 1 ? s.theta_m : s.theta_L;
     ++filled;
   };
-  o.sample_sink = keep;
   o.sample_theta_o_only = std::all_of(data_.which.begin(), data_.which.end(), [](int c) { return c == 0; });  // θo alone read
+  if (o.sample_theta_o_only && data_.which.size() == 1) {  // one column of θo: keep()'s work without its loop and choice
+    o.sample_sink = [column = (*out)[0].data(), row = rows.data(), count = rows.size(), &filled](const numeric::TrajectorySample& s) {
+      if (filled < count) column[row[filled]] = s.theta_o;
+      ++filled;
+    };
+  } else {
+    o.sample_sink = keep;
+  }
   ++simulations_;
   samples_ += static_cast<long>(rows.size());
   numeric::SimulationResult r;
@@ -165,7 +178,7 @@ Simulator::Traces Simulator::simulate(const ModelPoint& m, std::size_t samples, 
                  samples, m.e.describe().c_str());
   work_ += *cost;
   for (const numeric::TrajectorySample& s : r.samples) keep(s);  // a simulator that kept its samples
-  *events = r.events;
+  *events = std::move(r.events);  // r's are not read again
   for (numeric::SimulationEvent& event : *events) event.t += step_time_;  // on the record's clock
   if (r.status == numeric::SimulationStatus::NonFinite || r.status == numeric::SimulationStatus::EventLimit ||
       r.status == numeric::SimulationStatus::Chattering || filled != rows.size())
@@ -269,10 +282,10 @@ struct Objective {
   std::optional<std::vector<double>> residuals_at(const double* u) const {
     if (work.load() >= budget || weighted.load() / 4 >= budget || simulator.budget_reached()) return std::nullopt;
     ++calls;
-    std::vector<numeric::SimulationEvent> events;
+    std::size_t events = 0;  // their number alone
     long cost = 0;
-    const auto traces = simulator.traces(point(u), indices.back() + 1, &events, &cost, grid);
-    work += 1000 + static_cast<long>(events.size());
+    const auto traces = simulator.traces(point(u), indices.back() + 1, nullptr, &cost, grid, &events);
+    work += 1000 + static_cast<long>(events);
     weighted += cost;
     if (!traces) return std::nullopt;
     return residuals(data, *traces, indices);

@@ -89,8 +89,10 @@ class Simulator {
   /// `cost`, if given, receives the simulation's work (cost()).
   /// `grid`: Grid::fitted computes only the samples a fit reads (Observations::fit_indices); a
   /// simulation kept on the whole grid serves it too.
+  /// `event_count`, if given, receives the number of its events (for a caller that needs no more:
+  /// the events are not copied).
   Traces traces(const ModelPoint& m, std::size_t samples, std::vector<numeric::SimulationEvent>* events = nullptr,
-                long* cost = nullptr, Grid grid = Grid::all);
+                long* cost = nullptr, Grid grid = Grid::all, std::size_t* event_count = nullptr);
   /// A kept simulation (of `m` at this length, on this grid or the whole one) held past the last
   /// 256 kept for as long as the handle lives: a screened partner's best point, where its pair's
   /// fit starts once every other partner has been screened.  Empty if none is kept.
@@ -127,6 +129,9 @@ class Simulator {
   std::shared_ptr<const Kept> recall(const std::string& key);
   /// The record's rows a simulation of this length on this grid samples (ascending).
   std::vector<std::size_t> rows(std::size_t samples, Grid grid) const;
+  /// rows(samples, grid).size() without forming them (a fit's grid is as long as the whole
+  /// one exactly when it is the whole one).
+  std::size_t row_count(std::size_t samples, Grid grid) const;
   Traces simulate(const ModelPoint& m, std::size_t samples, const std::vector<std::size_t>& rows,
                   std::vector<numeric::SimulationEvent>* events, long* cost);
   void keep(const std::string& key, std::shared_ptr<const Kept> kept);

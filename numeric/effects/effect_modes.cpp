@@ -222,37 +222,45 @@ struct ModeFlow::Generic {
     diagonal = true;
   }
 
-  SmallVector at(double tau) const {
+  // The eigen-decomposition's weights w_j = e^{λ_j τ} q_j (diagonal only): cexp once per conjugate
+  // pair (cexp(z̄) is conj(cexp(z)), bit for bit) and not at all for λ = 0 (e^0 = 1).
+  ComplexVector5 weights(double tau) const {
     const int m = n + 1;
+    ComplexVector5 w = ComplexVector5::Zero();
+    for (int j = 0; j < m; ++j) {
+      if (lambda(j) == 0.0) {
+        w(j) = std::complex<double>(1, 0) * q(j);
+      } else if (j + 1 < m && lambda(j + 1) == std::conj(lambda(j)) && lambda(j).imag() != 0) {
+        const std::complex<double> e = std::exp(lambda(j) * tau);
+        w(j) = e * q(j);
+        w(j + 1) = std::conj(e) * q(j + 1);
+        ++j;
+      } else {
+        w(j) = std::exp(lambda(j) * tau) * q(j);
+      }
+    }
+    return w;
+  }
+  // z_i = Re Σ_j V_ij w_j: only the real parts are summed, each Re(V_ij w_j) = ac − bd as the
+  // complex product forms it (the full product, with its recovery of infinities, where that is NaN).
+  double row(int i, const ComplexVector5& w) const {
+    double sum = 0;
+    for (int j = 0; j <= n; ++j) sum += real_of_product(V(i, j), w(j));
+    return sum;
+  }
+
+  SmallVector at(double tau) const {
     if (diagonal) {
-      Eigen::Matrix<std::complex<double>, 5, 1> weights = Eigen::Matrix<std::complex<double>, 5, 1>::Zero();
-      // e^{λτ} by cexp once per conjugate pair (cexp(z̄) is conj(cexp(z)), bit for bit) and not at
-      // all for λ = 0 (e^0 = 1): the same weights.
-      for (int j = 0; j < m; ++j) {
-        if (lambda(j) == 0.0) {
-          weights(j) = std::complex<double>(1, 0) * q(j);
-        } else if (j + 1 < m && lambda(j + 1) == std::conj(lambda(j)) && lambda(j).imag() != 0) {
-          const std::complex<double> e = std::exp(lambda(j) * tau);
-          weights(j) = e * q(j);
-          weights(j + 1) = std::conj(e) * q(j + 1);
-          ++j;
-        } else {
-          weights(j) = std::exp(lambda(j) * tau) * q(j);
-        }
-      }
-      // z_i = Re Σ_j V_ij w_j: only the real parts are summed, each Re(V_ij w_j) = ac − bd as the
-      // complex product forms it (the full product, with its recovery of infinities, where that is NaN).
+      const ComplexVector5 w = weights(tau);
       SmallVector z(n);
-      for (int i = 0; i < n; ++i) {
-        double sum = 0;
-        for (int j = 0; j < m; ++j) sum += real_of_product(V(i, j), weights(j));
-        z(i) = sum;
-      }
+      for (int i = 0; i < n; ++i) z(i) = row(i, w);
       return z;
     }
     const MatrixUpTo5 E = (augmented * tau).exp();
-    return SmallVector((E * z0.head(m)).head(n));
+    return SmallVector((E * z0.head(n + 1)).head(n));
   }
+  /// at(τ)(i) alone (diagonal only: the exponential's product forms every row at once).
+  double at(double tau, int i) const { return row(i, weights(tau)); }
 };
 
 // ------------------------------------------------------------------ ModeFlow
@@ -496,11 +504,15 @@ SmallVector ModeFlow::local(double tau) const {
 
 // A contact's θo is state_of's θR + constant + z(0); a free flight's the measured shaft's start
 // plus its own local coordinate, from the kernels of its node alone (the load's are the same bits
-// whether coupled_kernels or phi_pair forms them; a motor driven by the moving load needs all).
+// whether coupled_kernels or phi_pair forms them; a motor driven by the moving load needs all); a
+// mesh mode's from its coordinate's row of the eigen-decomposition alone (each row is summed on its own).
 double ModeFlow::measured_at(double tau) const {
   const Mode& m = mode_;
-  if (generic_) return measured(p_, state(tau));
-  if (m.kind == ModeKind::Contact) return p_.theta_R + theta_o_constant_ + local(tau)(0);
+  if (generic_) {  // a mesh mode: its measured shaft's row of the eigen-decomposition alone
+    if (!generic_->diagonal) return measured(p_, state(tau));
+    return at_motor(p_) ? start_.theta_m + generic_->at(tau, 0) : start_.theta_L + generic_->at(tau, 2);
+  }
+  if (m.kind == ModeKind::Contact) return measured_of(local(tau));
   double position = 0, rate = 0;
   if (p_.measured_at == model::MeasuredAt::Motor) {
     if (motor_form_ == 3) return start_.theta_m + local(tau)(0);
@@ -509,6 +521,11 @@ double ModeFlow::measured_at(double tau) const {
   }
   load_part(tau, node_kernels(-a_ * tau, -b_ * tau, false, true), position, rate);
   return start_.theta_L + position;
+}
+
+double ModeFlow::measured_of(const SmallVector& z) const {
+  if (mode_.kind == ModeKind::Contact) return p_.theta_R + theta_o_constant_ + z(0);
+  return at_motor(p_) ? start_.theta_m + z(0) : start_.theta_L + z(2);
 }
 
 HybridState ModeFlow::state_of(const SmallVector& z) const {

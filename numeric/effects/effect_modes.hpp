@@ -114,6 +114,8 @@ class ModeFlow {
   double measured_at(double tau) const;
   /// The full state for local coordinates z.
   HybridState state_of(const SmallVector& z) const;
+  /// θo for local coordinates z, rad: measured(p, state_of(z)) bit for bit, without the state.
+  double measured_of(const SmallVector& z) const;
   /// The gap x = θL − θm for local coordinates z, and the measured shaft.
   double gap(const SmallVector& z) const;
   double theta_o(const SmallVector& z) const;

@@ -107,6 +107,11 @@ struct Step {
     const double s = (t - z[0].start()) / z[0].length();
     for (int i = 0; i < n; ++i) out(i) = z[i].value_at_fraction(s);
   }
+  /// Coordinate i of values(t, n, ·) alone.
+  double value(double t, int i) const {
+    if (!(z[0].length() > 0)) return z[static_cast<std::size_t>(i)].value(t);
+    return z[static_cast<std::size_t>(i)].value_at_fraction((t - z[0].start()) / z[0].length());
+  }
 };
 
 // Whether each witness is armed at the start (valid side), exits at once, departs from its
@@ -370,6 +375,10 @@ class DelayedSegment final : public Segment {
   DelayedSegment& operator=(const DelayedSegment&) = delete;
 
   HybridState state(double tau) const override { return state_of(z_at(t0_ + tau)); }
+  /// measured(p, state(τ)) from θo's coordinate alone (its one quintic, not the state's n).
+  double measured_at(const Parameters&, double tau) const override {
+    return measured(p_, start_) + z_at(t0_ + tau, theta_o_index());
+  }
 
   void extremes(double until, Extremes& x) const override {
     include(state(0), x);
@@ -457,6 +466,12 @@ class DelayedSegment final : public Segment {
     SmallVector z(n_);
     step.values(std::min(t, step.t1), n_, z);
     return z;
+  }
+  /// z_at(t)(i) alone (the same step found, the same operations).
+  double z_at(double t, int i) const {
+    if (steps_.empty() || t <= steps_.front().t0) return sys_.z0(i);
+    const Step& step = steps_[std::min(step_after(t), steps_.size() - 1)];
+    return step.value(std::min(t, step.t1), i);
   }
 
   // The first step whose end is beyond t (steps_.size() if none): std::upper_bound on the ends,

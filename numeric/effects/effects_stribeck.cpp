@@ -93,6 +93,7 @@ class StribeckSegment final : public Segment {
   }
 
   HybridState state(double tau) const override { return flow_.state_of(local(z_at(tau))); }
+  double measured_at(const Parameters&, double tau) const override { return flow_.measured_of(local(z_at(tau))); }
 
   void extremes(double until, Extremes& x) const override {
     include_extremes(p_, state(0), x);

@@ -36,7 +36,9 @@
 //                                 for bit, on every contact and free mode of cases I, II (at the motor)
 //                                 and V, VIII (at the load) with each motor form, from random starts; a
 //                                 run sampling θo alone (SimulationOptions::sample_theta_o_only) has the
-//                                 full run's θo samples and events, its other fields NaN.
+//                                 full run's θo samples and events, its other fields NaN — with closed
+//                                 forms, a compliant mesh, a delay (rigid and meshed), Stribeck friction;
+//                                 a mesh mode's θo alone is its state's on case V's mesh flows.
 #include "effects/effect_modes.hpp"
 #include "effects/effects_engine.hpp"
 #include "evaluators/phi_functions.hpp"
@@ -381,29 +383,56 @@ TEST(EffectsEngineSearches, check_theta_o_alone_as_the_state) {
   EXPECT_GT(contacts, 0);
   EXPECT_GT(free_at_motor, 0);
   EXPECT_GT(free_at_load, 0);
-  // Whole runs: the samples of θo alone against the full ones.
-  for (const char* id : {"I", "V"}) {
-    const model::CaseSpec spec = model::load_case(id);
-    const numeric::ValidationResult nominal = numeric::validate(numeric::case_evaluator(spec));
-    ASSERT_TRUE(nominal.passed());
-    const numeric::EffectValidationResult gate = numeric::validate_effects(nominal.evaluator(), sets[3]);
-    ASSERT_TRUE(gate.passed()) << id;
-    numeric::SimulationOptions full;
-    full.t_end = 30;
-    for (int k = 0; k <= 3000; ++k) full.sample_times.push_back(0.01 * k);
-    numeric::SimulationOptions alone = full;
-    alone.sample_theta_o_only = true;
-    const numeric::SimulationResult a = numeric::simulate_effects_step(gate.model(), 0.62, full, {.general_engine = true});
-    const numeric::SimulationResult b = numeric::simulate_effects_step(gate.model(), 0.62, alone, {.general_engine = true});
-    ASSERT_EQ(a.samples.size(), full.sample_times.size()) << id;
-    ASSERT_EQ(b.samples.size(), a.samples.size()) << id;
-    ASSERT_EQ(b.events.size(), a.events.size()) << id;
-    EXPECT_GT(a.events.size(), 2u) << id;
-    for (std::size_t k = 0; k < a.samples.size(); ++k) {
-      EXPECT_TRUE(same_bits(a.samples[k].t, b.samples[k].t) && same_bits(a.samples[k].theta_o, b.samples[k].theta_o))
-          << "case " << id << ", sample " << k << ": returned " << b.samples[k].theta_o << " instead of " << a.samples[k].theta_o;
-      EXPECT_TRUE(std::isnan(b.samples[k].theta_m) && std::isnan(b.samples[k].dtheta_L)) << id << ", sample " << k;
+  // The mesh modes' flows (case V, at the load), by their eigen-decomposition or the exponential.
+  const numeric::Parameters case_v = numeric::parameters_of(model::load_case("V"));
+  int meshes = 0;
+  for_mesh_flows(random, 6, [&](const numeric::Mode& m, const numeric::ModeFlow& flow) {
+    for (double tau : {0.0, 1e-3, 0.3, 2.0, 17.0}) {
+      const double got = flow.measured_at(tau), expected = numeric::measured(case_v, flow.state(tau));
+      EXPECT_TRUE(same_bits(got, expected)) << m.describe() << ", tau " << tau << ": returned " << got << " instead of " << expected;
     }
-    for (std::size_t i = 0; i < a.events.size(); ++i) EXPECT_TRUE(same_bits(a.events[i].t, b.events[i].t)) << id << ", event " << i;
-  }
+    ++meshes;
+  });
+  EXPECT_GT(meshes, 0);
+  // Whole runs: the samples of θo alone against the full ones, for each kind of segment — closed
+  // forms (rigid and mesh), the delayed model's integration (rigid and mesh), Stribeck friction's.
+  std::vector<std::pair<const char*, numeric::Effects>> runs{{"closed forms", sets[3]}};
+  runs.emplace_back("mesh", compliance());
+  runs.back().second.coulomb_load = 0.02;
+  runs.emplace_back("delay", sets[3]);
+  runs.back().second.delay = 0.05;
+  runs.emplace_back("delayed mesh", compliance());
+  runs.back().second.delay = 0.02;
+  runs.emplace_back("Stribeck", numeric::Effects{});
+  runs.back().second.stribeck_motor_static = 0.03, runs.back().second.stribeck_motor_kinetic = 0.02;
+  runs.back().second.stribeck_motor_velocity = 0.05;
+  for (const char* id : {"I", "V"})
+    for (const auto& [kind, effects] : runs) {
+      const std::string what = std::string("case ") + id + ", " + kind;
+      const model::CaseSpec spec = model::load_case(id);
+      const numeric::ValidationResult nominal = numeric::validate(numeric::case_evaluator(spec));
+      ASSERT_TRUE(nominal.passed());
+      const numeric::EffectValidationResult gate = numeric::validate_effects(nominal.evaluator(), effects);
+      ASSERT_TRUE(gate.passed()) << what;
+      numeric::SimulationOptions full;
+      full.t_end = 30;
+      for (int k = 0; k <= 3000; ++k) full.sample_times.push_back(0.01 * k);
+      numeric::SimulationOptions alone = full;
+      alone.sample_theta_o_only = true;
+      const numeric::SimulationResult a = numeric::simulate_effects_step(gate.model(), 0.62, full, {.general_engine = true});
+      const numeric::SimulationResult b = numeric::simulate_effects_step(gate.model(), 0.62, alone, {.general_engine = true});
+      ASSERT_EQ(a.samples.size(), full.sample_times.size()) << what;
+      ASSERT_EQ(b.samples.size(), a.samples.size()) << what;
+      ASSERT_EQ(b.events.size(), a.events.size()) << what;
+      EXPECT_GT(a.events.size(), 2u) << what;
+      int differing = 0;
+      for (std::size_t k = 0; k < a.samples.size(); ++k) {
+        const bool same = same_bits(a.samples[k].t, b.samples[k].t) && same_bits(a.samples[k].theta_o, b.samples[k].theta_o);
+        if (!same && ++differing <= 3)
+          ADD_FAILURE() << what << ", sample " << k << ": returned " << b.samples[k].theta_o << " instead of " << a.samples[k].theta_o;
+        EXPECT_TRUE(std::isnan(b.samples[k].theta_m) && std::isnan(b.samples[k].dtheta_L)) << what << ", sample " << k;
+      }
+      EXPECT_EQ(differing, 0) << what;
+      for (std::size_t i = 0; i < a.events.size(); ++i) EXPECT_TRUE(same_bits(a.events[i].t, b.events[i].t)) << what << ", event " << i;
+    }
 }
