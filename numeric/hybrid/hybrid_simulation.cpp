@@ -339,7 +339,7 @@ class ClosedFormRun {
     result_.t_final = t_;
     result_.final_state = state_;
     result_.theta_o_final = measured(p_, state_);
-    return result_;
+    return std::move(result_);  // the run ends here: its events are not copied
   }
   SimulationResult stop(SimulationStatus status, std::string reason) {
     result_.stop_reason = std::move(reason);
