@@ -215,7 +215,7 @@ class EndStack {
  public:
   bool empty() const { return size_ == 0; }
   End& back() { return size_ <= kInline ? inline_[size_ - 1] : spill_.back(); }
-  void push_back(const End& end) {
+  [[gnu::always_inline]] void push_back(const End& end) {
     if (size_ < kInline) inline_[size_] = end;
     else spill_.push_back(end);
     ++size_;

@@ -13,6 +13,7 @@ using detail::growth_bound;
 using detail::kSampleNoise;
 using detail::Sampler;
 using detail::search;
+using detail::StartRates;
 
 namespace {
 
@@ -121,13 +122,8 @@ void WitnessMode::set_forcing(const SmallVector& forcing) {
 
 namespace {
 
-// At a start x0: ‖D x'(0)‖∞ (‖D x'(t)‖∞ ≤ e^{μ t} of it), w''(0) = eA x'(0), w'''(0) = eA² x'(0) and
-// ‖x0‖∞, with x'(0) = A x0 + c — for the modes' sizes by the Sampler's unrolled products (Eigen's
+// start_rates (gap_events.hpp) for the modes' sizes by the Sampler's unrolled products (Eigen's
 // order of operations, the same bits), otherwise by Eigen.
-struct StartRates {
-  double z0, second, third, x_size;
-};
-
 template <int N>
 StartRates start_rates_of(const WitnessMode& W, const double* x) {
   double z[N];
@@ -137,17 +133,20 @@ StartRates start_rates_of(const WitnessMode& W, const double* x) {
   return {z0, detail::dot_of<N>(W.eA, z), detail::dot_of<N>(W.eA2, z), size};
 }
 
-StartRates start_rates(const WitnessMode& W, const SmallVector& x0) {
+}  // namespace
+
+StartRates detail::start_rates(const WitnessMode& W, const SmallVector& x0) {
   if (x0.size() == 4 && W.A.rows() == 4) return start_rates_of<4>(W, x0.data());
   if (x0.size() == 2 && W.A.rows() == 2) return start_rates_of<2>(W, x0.data());
   const SmallVector z = W.A * x0 + W.c;
   return {z.cwiseProduct(W.scale).cwiseAbs().maxCoeff(), W.eA.dot(z), W.eA2.dot(z), x0.cwiseAbs().maxCoeff()};
 }
 
-}  // namespace
-
 std::optional<double> certified_departure(const WitnessMode& W, const SmallVector& x0, double noise) {
-  const StartRates r = start_rates(W, x0);
+  return detail::certified_departure(W, detail::start_rates(W, x0), noise);
+}
+
+std::optional<double> detail::certified_departure(const WitnessMode& W, const StartRates& r, double noise) {
   const double z0 = r.z0;          // ‖D x'(0)‖∞, ‖D x'(t)‖∞ ≤ e^{μ t} z0
   const double second = r.second;  // w''(0) = eA x'(0)
   const double third = r.third;    // w'''(0) = eA² x'(0)
@@ -202,7 +201,10 @@ LeadingTerm leading_term(const WitnessMode& W, const StartRates& r, double t0, d
 }  // namespace
 
 double certified_clearance(const WitnessMode& W, const SmallVector& x0, double t0, double noise) {
-  const StartRates r = start_rates(W, x0);
+  return detail::certified_clearance(W, detail::start_rates(W, x0), t0, noise);
+}
+
+double detail::certified_clearance(const WitnessMode& W, const StartRates& r, double t0, double noise) {
   const double z0 = r.z0;
   const double second = std::fabs(r.second), third = std::fabs(r.third);
   const double growth = std::max(0.0, W.mu_A);
@@ -221,8 +223,8 @@ double certified_clearance(const WitnessMode& W, const SmallVector& x0, double t
   }
 }
 
-int detail::departure_sign(const WitnessMode& W, const SmallVector& x0, double t0, double noise) {
-  return leading_term(W, start_rates(W, x0), t0, noise).sign;
+int detail::departure_sign(const WitnessMode& W, const StartRates& r, double t0, double noise) {
+  return leading_term(W, r, t0, noise).sign;
 }
 
 std::optional<double> certified_departure(const LinearWitness& witness, double noise) {

@@ -50,10 +50,22 @@ std::optional<GapEvent> first_gap_event(const WitnessMode& gap_mode, FunctionRef
 std::optional<GapEvent> first_gap_event_inside(const WitnessMode& gap_mode, FunctionRef<WitnessSample(double)> sample,
                                                double start_gap, int face, double half, double horizon);
 
+/// A witness's rates at a start x0: ‖D x'(0)‖∞ (‖D x'(t)‖∞ ≤ e^{μ t} of it), w''(0) = eA x'(0),
+/// w'''(0) = eA² x'(0) and ‖x0‖∞, with x'(0) = A x0 + c: what certified_departure,
+/// certified_clearance and departure_sign read of x0, computed once per flight.
+struct StartRates {
+  double z0, second, third, x_size;
+};
+StartRates start_rates(const WitnessMode& mode, const SmallVector& x0);
+
+/// certified_departure and certified_clearance (first_crossing.hpp) from the start's rates.
+std::optional<double> certified_departure(const WitnessMode& mode, const StartRates& rates, double noise);
+double certified_clearance(const WitnessMode& mode, const StartRates& rates, double t0, double noise);
+
 /// The sign of w near the start (its leading term's, w''(0) or w'''(0), on (0, t0]) when
 /// certified_clearance judges that term resolved from rounding and noise (first_crossing.hpp);
 /// 0 when it does not.
-int departure_sign(const WitnessMode& mode, const SmallVector& x0, double t0, double noise);
+int departure_sign(const WitnessMode& mode, const StartRates& rates, double t0, double noise);
 
 /// The gap witness's mode: e = θL − θm on the free segment.
 WitnessMode gap_witness_mode(const LinearSegment& free_segment, double time_unit);
@@ -131,7 +143,8 @@ std::optional<GapEvent> first_gap_event_with(const WitnessMode& gap_mode, const 
   // Return to the face left: Δx starts as O(t²) or O(t³), below rounding noise at first.
   const double noise = 1e-10 * std::max(1.0, position_scale);
   const SmallVector& x0 = start.x;
-  const std::optional<double> t0 = certified_departure(gap_mode, x0, noise);
+  const StartRates rates = start_rates(gap_mode, x0);
+  const std::optional<double> t0 = certified_departure(gap_mode, rates, noise);
   if (!t0) {
     const std::optional<Crossing> only = certified_first_crossing(gap_mode, counted, opposite_face_change, 0, horizon);
     if (only) return GapEvent{GapEventKind::OppositeFace, *only, 0, false, {}};
@@ -139,7 +152,7 @@ std::optional<GapEvent> first_gap_event_with(const WitnessMode& gap_mode, const 
   }
   double clear = NAN;  // certified_clearance, computed when the return is searched
   const auto cleared = [&] {
-    if (std::isnan(clear)) clear = certified_clearance(gap_mode, x0, *t0, noise);
+    if (std::isnan(clear)) clear = certified_clearance(gap_mode, rates, *t0, noise);
     return clear;
   };
   const auto back = [&](double lo, double hi) {
@@ -151,7 +164,7 @@ std::optional<GapEvent> first_gap_event_with(const WitnessMode& gap_mode, const 
   const auto back_start = [&] { return cleared() > *t0 ? std::min(clear, horizon) : *t0; };
   const Level first{opposite, zero}, second{back, back_start};
   const bool first_settles =
-      turns_once && no_return_before_opposite_face(departure_sign(gap_mode, x0, *t0, noise), opposite_face_change);
+      turns_once && no_return_before_opposite_face(departure_sign(gap_mode, rates, *t0, noise), opposite_face_change);
   // A quiet tail needs the motor free of the load (A(1, 2) = 0, the output at the motor): for the
   // output at the load (cases III–VIII) the call is not made at all.
   const bool motor_free = gap_mode.A.rows() == 4 && gap_mode.A(1, 2) == 0;

@@ -323,8 +323,9 @@ class ClosedFormRun {
         if (events_ >= o_.max_events)
           return stop(SimulationStatus::EventLimit, event_limit_reason(o_));
         static const std::string motion = "the motion";
-        if (auto problem = resolution_problem(p_, motion_scale(p_, state_.theta_m, state_.theta_L), motion))
-          return stop(SimulationStatus::Unresolved, *problem);
+        const double scale = motion_scale(p_, state_.theta_m, state_.theta_L);
+        if (!motion_resolved(scale, resolvable_scale_))
+          if (auto problem = resolution_problem(p_, scale, motion)) return stop(SimulationStatus::Unresolved, *problem);
         const std::optional<SimulationStatus> end = state_.in_contact ? contact() : flight();
         if (end) return finish(*end);
       }
@@ -339,7 +340,7 @@ class ClosedFormRun {
     result_.t_final = t_;
     result_.final_state = state_;
     result_.theta_o_final = measured(p_, state_);
-    return result_;
+    return std::move(result_);  // the run ends here: its events are not copied
   }
   SimulationResult stop(SimulationStatus status, std::string reason) {
     result_.stop_reason = std::move(reason);
@@ -389,6 +390,7 @@ class ClosedFormRun {
   const double cancellation_scale_;  // see torque_sample
   const bool rigid_;
   const double zeno_window_;  // zeno_window(p_, o_), once per run
+  const double resolvable_scale_ = resolvable_scale(p_);  // once per run
   HybridState state_;
   std::optional<double> start_gap_;  // the first flight's gap x(0) when it starts inside the backlash
   const std::optional<Band> band_;  // options.sample_band in this run's frame (band_in_frame)

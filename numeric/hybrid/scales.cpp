@@ -192,7 +192,7 @@ double motion_scale(const Parameters& p, double theta_m, double theta_L) {
 }
 
 std::optional<std::string> resolution_problem(const Parameters& p, double scale, const std::string& what) {
-  if (std::isfinite(scale) && (p.backlash <= 0 || scale <= resolvable_scale(p))) return std::nullopt;
+  if (motion_resolved(scale, resolvable_scale(p))) return std::nullopt;  // (infinite for b = 0)
   if (!std::isfinite(scale)) return what + " makes the motion overflow double precision";
   return what + " makes the motion " + number(scale) + " rad in size, where double precision resolves angles to " +
          number(scale * std::numeric_limits<double>::epsilon()) + " rad, more than " + number(backlash_resolution) +

@@ -22,6 +22,7 @@
 
 #include "backlash/numeric/parametric.hpp"
 
+#include <cmath>
 #include <optional>
 #include <string>
 
@@ -65,6 +66,10 @@ double resolvable_scale(const Parameters& p);
 
 /// The size of a state's motion for the resolution rule: max(|θm − θR|, |θL − θR|) + |θR|.
 double motion_scale(const Parameters& p, double theta_m, double theta_L);
+
+/// Whether a motion of size `scale` is resolved, `resolvable` being resolvable_scale(p): finite and
+/// at most that (resolution_problem's rule, for a loop that keeps resolvable_scale(p)).
+inline bool motion_resolved(double scale, double resolvable) { return std::isfinite(scale) && scale <= resolvable; }
 
 /// Why a motion of size `scale` cannot be resolved, or nothing; `what` names its origin
 /// ("the step 1e16", "the velocity 1e20").
