@@ -26,27 +26,33 @@ void append_number(std::string& out, double value) {
   out.append(text, result.ptr);
 }
 
-// The texts of a row's numbers, column by column, kept from the row before on this thread: a
-// map's rows repeat most of their columns (the fixed parameters and effects, the slower axes),
-// and a number's text depends on its bits alone — a kept text is the one append_number writes.
+// The texts of a row's numbers, column by column, kept on this thread by their bits (a small
+// direct-mapped table per column): a map's rows repeat most of their columns (the fixed
+// parameters and effects, the slower axes), and the fast axis's columns cycle through the same
+// few values row after row; a number's text depends on its bits alone — a kept text is the one
+// append_number writes.
 class ColumnTexts {
  public:
   void append(std::string& out, std::size_t column, double value) {
     if (column >= kept_.size()) kept_.resize(column + 1);
-    Kept& k = kept_[column];
+    std::vector<Kept>& table = kept_[column];
+    if (table.empty()) table.resize(kSlots);
     std::uint64_t bits = 0;
     std::memcpy(&bits, &value, sizeof bits);
+    Kept& k = table[(bits * 0x9E3779B97F4A7C15ULL) >> (64 - kSlotBits)];
     if (!k.valid || k.bits != bits) k.text.clear(), append_number(k.text, value), k.bits = bits, k.valid = true;
     out += k.text;
   }
 
  private:
+  static constexpr int kSlotBits = 8;
+  static constexpr std::size_t kSlots = std::size_t{1} << kSlotBits;
   struct Kept {
     std::uint64_t bits = 0;
     bool valid = false;
     std::string text;  ///< append_number's (short: within the small-string buffer)
   };
-  std::vector<Kept> kept_;
+  std::vector<std::vector<Kept>> kept_;
 };
 
 void append_quoted(std::string& out, const std::string& text) {

@@ -4,7 +4,9 @@
 #include "hybrid/certified_search.hpp"
 #include "hybrid/gap_events.hpp"
 
+#include <array>
 #include <cmath>
+#include <cstring>
 #include <functional>
 
 namespace backlash::numeric {
@@ -227,8 +229,53 @@ int detail::departure_sign(const WitnessMode& W, const StartRates& r, double t0,
   return leading_term(W, r, t0, noise).sign;
 }
 
+namespace {
+
+// The bits of a kept mode's inputs: A's shape, A, c, e and the time unit.
+struct ModeKey {
+  std::array<double, 16 + 4 + 4 + 1> bits{};
+  Eigen::Index rows = -1, cols = -1, forcing = -1, row = -1;
+  ModeKey(const SmallMatrix& A, const SmallVector& c, const SmallRow& e, double time_unit)
+      : rows(A.rows()), cols(A.cols()), forcing(c.size()), row(e.size()) {
+    double* at = bits.data();
+    at = std::copy(A.data(), A.data() + A.size(), at);
+    at = std::copy(c.data(), c.data() + c.size(), at);
+    at = std::copy(e.data(), e.data() + e.size(), at);
+    *at = time_unit;
+  }
+  bool operator==(const ModeKey& o) const {
+    return rows == o.rows && cols == o.cols && forcing == o.forcing && row == o.row &&
+           std::memcmp(bits.data(), o.bits.data(), sizeof bits) == 0;
+  }
+};
+
+}  // namespace
+
+WitnessMode detail::kept_witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e, double time_unit) {
+  if (A.size() > 16 || c.size() > 4 || e.size() > 4) return WitnessMode(A, c, e, time_unit);
+  struct Kept {
+    ModeKey key;
+    WitnessMode mode;
+    long used = 0;
+  };
+  thread_local std::array<std::optional<Kept>, 4> kept;
+  thread_local long clock = 0;
+  const ModeKey key(A, c, e, time_unit);
+  std::optional<Kept>* oldest = &kept[0];
+  for (std::optional<Kept>& k : kept) {
+    if (k && k->key == key) {
+      k->used = ++clock;
+      return k->mode;
+    }
+    if (!k || (*oldest && k->used < (*oldest)->used)) oldest = &k;  // an empty slot, else the least recently used
+  }
+  oldest->emplace(Kept{key, WitnessMode(A, c, e, time_unit), ++clock});
+  return (*oldest)->mode;
+}
+
 std::optional<double> certified_departure(const LinearWitness& witness, double noise) {
-  return certified_departure(WitnessMode(witness.A, witness.c, witness.e, witness.time_unit), witness.state(0), noise);
+  return certified_departure(detail::kept_witness_mode(witness.A, witness.c, witness.e, witness.time_unit),
+                             witness.state(0), noise);
 }
 
 std::optional<Crossing> first_crossing(const WitnessMode& mode, FunctionRef<WitnessSample(double)> sample, double level,
@@ -245,7 +292,7 @@ std::optional<Crossing> first_crossing_after_departure(const WitnessMode& mode, 
 std::optional<Crossing> first_crossing(const LinearWitness& witness, double t_begin, double t_end,
                                        const CrossingOptions& options) {
   if (!(t_end > t_begin)) return std::nullopt;
-  const WitnessMode mode(witness.A, witness.c, witness.e, witness.time_unit);
+  const WitnessMode mode = detail::kept_witness_mode(witness.A, witness.c, witness.e, witness.time_unit);
   const auto sample = [&witness](double t) { return sample_of(witness, t); };
   const std::function<double(double, double)>* bound =
       witness.third_derivative_bound ? &witness.third_derivative_bound : nullptr;

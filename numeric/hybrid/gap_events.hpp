@@ -67,6 +67,12 @@ double certified_clearance(const WitnessMode& mode, const StartRates& rates, dou
 /// 0 when it does not.
 int departure_sign(const WitnessMode& mode, const StartRates& rates, double t0, double noise);
 
+/// WitnessMode(A, c, e, time_unit), kept by the exact bits of its inputs (this thread's last
+/// four): the same inputs give the same bits, so a kept mode is the one building it again would
+/// give.  A map's points share their contact segment where they keep Jm + JL, Fm + FL and K
+/// (docs/design.md, "Design-space maps"): its velocity's and θo's witnesses repeat there.
+WitnessMode kept_witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e, double time_unit);
+
 /// The gap witness's mode: e = θL − θm on the free segment.
 WitnessMode gap_witness_mode(const LinearSegment& free_segment, double time_unit);
 

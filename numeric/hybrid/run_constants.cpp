@@ -17,9 +17,12 @@ namespace {
 std::atomic<long> built{0};
 
 // The witness of one velocity (row of x) on a segment: its zeros are the extremes of the angle.
+// The contact segment's is kept by its inputs' bits: a map's points share that segment
+// (kept_witness_mode); the free segment's change with the split of J and F.
 WitnessMode velocity_mode(const LinearSegment& segment, Eigen::Index row, double time_unit) {
   SmallRow e = SmallRow::Zero(segment.A.rows());
   e(row) = 1;
+  if (segment.A.rows() == 2) return detail::kept_witness_mode(segment.A, segment.c, e, time_unit);
   return WitnessMode(segment.A, segment.c, e, time_unit);
 }
 
