@@ -10,7 +10,6 @@
 #include "map_store.hpp"
 
 #include "backlash/numeric/validated_family.hpp"
-#include "backlash/reports/plot.hpp"
 
 #include <cstdio>
 #include <cstring>
@@ -277,7 +276,6 @@ MapSummary write_map(const MapRequest& request, const MapOutput& output) {
   }
   if (t && t->size() > 1) t->broadcast(start);
   if (start.rfind("error ", 0) == 0) throw BadInput("out", start.substr(6));
-  if (root && output.figures) reports::start_gnuplot_early();  // its start-up beside the points (plot.hpp)
   MapSummary summary;
   summary.points = plan.count();
   summary.resumed_from = std::stol(start.substr(3));

@@ -4,7 +4,6 @@
 #include "backlash/symbolic/escape.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdint>
@@ -13,18 +12,9 @@
 #include <fstream>
 #include <iterator>
 #include <limits>
-#include <mutex>
-#include <optional>
 #include <sstream>
 
-#include <fcntl.h>
-#include <signal.h>
-#include <spawn.h>
 #include <stdlib.h>  // mkdtemp (POSIX)
-#include <sys/wait.h>
-#include <unistd.h>
-
-extern char** environ;
 
 namespace backlash::reports {
 
@@ -347,99 +337,11 @@ std::string figure_body(const Plot& plot, std::size_t f, bool heat_image) {
   return body.str();
 }
 
-// A gnuplot started early (start_gnuplot_early), reading its commands from a pipe; its
-// standard output and error go to an unlinked temporary file read back at the end.
-struct WaitingGnuplot {
-  pid_t pid = -1;
-  int commands = -1;  // the pipe's writing end
-  int log = -1;
-};
-std::mutex waiting_mutex;
-std::optional<WaitingGnuplot> waiting;
-
-std::optional<WaitingGnuplot> spawn_gnuplot() {
-  char log_name[] = "/tmp/backlash-gnuplot-XXXXXX";
-  const int log = mkostemp(log_name, O_CLOEXEC);
-  if (log < 0) return std::nullopt;
-  unlink(log_name);
-  int pipe_ends[2];
-  if (pipe2(pipe_ends, O_CLOEXEC) != 0) return close(log), std::nullopt;
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_adddup2(&actions, pipe_ends[0], 0);
-  posix_spawn_file_actions_adddup2(&actions, log, 1);
-  posix_spawn_file_actions_adddup2(&actions, log, 2);
-  char name[] = "gnuplot";
-  char* argv[] = {name, nullptr};
-  pid_t pid = -1;
-  const int failed = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
-  posix_spawn_file_actions_destroy(&actions);
-  close(pipe_ends[0]);
-  if (failed != 0) return close(pipe_ends[1]), close(log), std::nullopt;
-  return WaitingGnuplot{pid, pipe_ends[1], log};
-}
-
-// Writes all of `text` to `fd`; false when the reader is gone (SIGPIPE held back and consumed).
-bool write_all(int fd, const std::string& text) {
-  sigset_t pipe_signal, before;
-  sigemptyset(&pipe_signal);
-  sigaddset(&pipe_signal, SIGPIPE);
-  pthread_sigmask(SIG_BLOCK, &pipe_signal, &before);
-  bool ok = true;
-  for (std::size_t at = 0; ok && at < text.size();) {
-    const ssize_t n = write(fd, text.data() + at, text.size() - at);
-    if (n > 0) at += static_cast<std::size_t>(n);
-    else if (!(n < 0 && errno == EINTR)) ok = false;
-  }
-  if (!ok) {
-    const timespec zero{0, 0};
-    sigtimedwait(&pipe_signal, nullptr, &zero);
-  }
-  pthread_sigmask(SIG_SETMASK, &before, nullptr);
-  return ok;
-}
-
-// gnuplot's exit status and log from the waiting one run on `script_file` in `directory`
-// (cd, then load: as `gnuplot figures.gp` there, stopping at its first error); nothing when it
-// was gone before it got the commands.
-std::optional<std::pair<int, std::string>> run_waiting(WaitingGnuplot g, const std::filesystem::path& directory,
-                                                       const std::string& script_file) {
-  const std::string commands = "cd " + quoted(std::filesystem::absolute(directory).string(), true) + "\nload " +
-                               quoted(script_file, true) + "\n";
-  const bool sent = write_all(g.commands, commands);
-  close(g.commands);
-  int status = 0;
-  while (waitpid(g.pid, &status, 0) < 0 && errno == EINTR) {}
-  std::string log;
-  char buffer[4096];
-  for (off_t at = 0;;) {
-    const ssize_t n = pread(g.log, buffer, sizeof buffer, at);
-    if (n <= 0) break;
-    log.append(buffer, static_cast<std::size_t>(n)), at += n;
-  }
-  close(g.log);
-  if (!sent) return std::nullopt;
-  return std::make_pair(WIFEXITED(status) ? WEXITSTATUS(status) : 1, log);
-}
-
-// The reason gnuplot failed: its log's last non-empty line, without leading blanks.
-std::string failure_of(std::istream& log) {
-  std::string line, last;
-  while (std::getline(log, line))
-    if (line.find_first_not_of(" \t") != std::string::npos) last = line.substr(line.find_first_not_of(" \t"));
-  return "gnuplot failed: " + last;
-}
-
 // Runs gnuplot once in `directory` on every plot: figures/NAME.svg, and with `pdf`
 // figures/NAME.pdf (date-fixed).  The script and gnuplot's log are removed.
 std::optional<std::string> run_gnuplot(const std::vector<Plot>& plots, const std::filesystem::path& directory, bool pdf) {
   namespace fs = std::filesystem;
-  std::optional<WaitingGnuplot> early;
-  {
-    const std::lock_guard<std::mutex> lock(waiting_mutex);
-    early.swap(waiting);
-  }
-  if (!early && std::system("command -v gnuplot > /dev/null 2>&1") != 0) return std::string("gnuplot is not installed");
+  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) return std::string("gnuplot is not installed");
   std::ostringstream script;
   script << "set encoding utf8\n";
   for (std::size_t f = 0; f < plots.size(); ++f) {
@@ -461,25 +363,19 @@ std::optional<std::string> run_gnuplot(const std::vector<Plot>& plots, const std
   {
     std::ofstream out(script_file, std::ios::binary);
     out << script.str();
-    if (!out) {
-      if (early) close(early->commands), close(early->log), waitpid(early->pid, nullptr, 0);
-      return std::string("cannot write the gnuplot script");
-    }
+    if (!out) return std::string("cannot write the gnuplot script");
   }
   fs::create_directories(directory / "figures");
   const fs::path log = directory / "figures.log";
+  const std::string command = "cd " + output::shell_word(directory.string()) + " && gnuplot figures.gp > figures.log 2>&1";
+  const int status = std::system(command.c_str());
   std::optional<std::string> failure;
-  std::optional<std::pair<int, std::string>> ran;
-  if (early) ran = run_waiting(*early, directory, script_file.filename().string());
-  if (ran) {
-    std::istringstream in(ran->second);
-    if (ran->first != 0) failure = failure_of(in);
-  } else {
-    const std::string command = "cd " + output::shell_word(directory.string()) + " && gnuplot figures.gp > figures.log 2>&1";
-    if (std::system(command.c_str()) != 0) {
-      std::ifstream in(log);
-      failure = failure_of(in);
-    }
+  if (status != 0) {
+    std::ifstream in(log);
+    std::string line, last;
+    while (std::getline(in, line))
+      if (!line.empty()) last = line;
+    failure = "gnuplot failed: " + last;
   }
   std::error_code ignored;
   fs::remove(script_file, ignored);
@@ -493,11 +389,6 @@ std::optional<std::string> run_gnuplot(const std::vector<Plot>& plots, const std
 }
 
 }  // namespace
-
-void start_gnuplot_early() {
-  const std::lock_guard<std::mutex> lock(waiting_mutex);
-  if (!waiting) waiting = spawn_gnuplot();
-}
 
 std::optional<std::string> render_figures(const std::vector<Plot>& plots, const std::filesystem::path& directory) {
   return run_gnuplot(plots, directory, true);

@@ -90,13 +90,6 @@ struct Plot {
   std::optional<Bars> bars;           ///< a bar chart (rows at y = 0, 1, …; y axis reversed, named)
 };
 
-/// Starts gnuplot now, idle until the next render_figures or render_svgs hands it its script:
-/// its start-up (loading its libraries and fonts, ≈ 0.03–0.1 s of wall time) then overlaps the
-/// caller's work (a map's points) instead of following it.  The figures are the same bytes;
-/// an unused one ends when this process does.  Does nothing when one is waiting already or
-/// gnuplot cannot be started (render_* then start their own).
-void start_gnuplot_early();
-
 /// Draws every plot into `directory`/figures (NAME.svg, NAME.pdf).  Returns the reason
 /// when nothing could be drawn (gnuplot missing or failing), else nothing.
 std::optional<std::string> render_figures(const std::vector<Plot>& plots, const std::filesystem::path& directory);
