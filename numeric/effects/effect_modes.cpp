@@ -249,7 +249,7 @@ struct ModeFlow::Generic {
     return sum;
   }
 
-  SmallVector at(double tau) const {
+  [[gnu::noinline]] SmallVector at(double tau) const {  // out of local(): inlined, its frame slows every closed-form flow
     if (diagonal) {
       const ComplexVector5 w = weights(tau);
       SmallVector z(n);
