@@ -547,12 +547,12 @@ void ClosedFormRun::record(double upto, const At& at, FunctionRef<int(double, do
   if (!band_) return recorder_.record(t_, upto, at);
   const auto keep = [this](double o) { return keep_sample(o); };
   const auto last = [this](double o) { return last_sample(o); };
-  std::array<double, TrajectoryRecorder::kMaxTurns> times;
+  std::array<double, 8> times;
   const int count = turns(upto - t_, times.data(), static_cast<int>(times.size()));
   bool skip = count >= 0 && !keep(measured(p_, at(0))) && !keep(measured(p_, at(upto - t_)));
   for (int i = 0; skip && i < count; ++i) skip = !keep(measured(p_, at(times[i])));
   if (skip) recorder_.skip(upto);
-  else recorder_.defer_last_outside(t_, upto, at, keep, last, times.data(), count);  // `at` kept by value: it owns its segment
+  else recorder_.defer_last_outside(t_, upto, at, keep, last);  // `at` kept by value: it owns its segment
 }
 
 // A return to the face just left, found within the search's resolution of the certified

@@ -29,7 +29,6 @@
 
 #include "backlash/numeric/validation.hpp"
 
-#include <array>
 #include <cmath>
 #include <functional>
 #include <optional>
@@ -204,11 +203,8 @@ class TrajectoryRecorder {
   /// time order, the others counted as left out.  Deferred (issue 19): only the last sample now;
   /// the walk waits, `at` kept, until a later segment's last sample is certainly outside (then the
   /// samples before it are not needed: all left out) or the run ends (flush).  With sample_times: record().
-  /// `turns`: the times τ in (0, t_upto − t0) where the segment's θo may turn, ascending (at most
-  /// kMaxTurns; `turn_count` < 0 when unknown): between them θo is monotone, which the walk uses.
   template <class At, class Keep, class Last>
-  void defer_last_outside(double t0, double t_upto, const At& at, const Keep& keep, const Last& last,
-                          const double* turns = nullptr, int turn_count = -1) {
+  void defer_last_outside(double t0, double t_upto, const At& at, const Keep& keep, const Last& last) {
     if (!o_.sample_times.empty() || o_.sample_interval <= 0) return record(t0, t_upto, at);
     const long long first = k_;
     while (static_cast<double>(k_) * o_.sample_interval <= t_upto) ++k_;
@@ -217,9 +213,7 @@ class TrajectoryRecorder {
     const HybridState end = at(t - t0);
     if (!last(measured(p_, end))) {
       if (pending_.size() >= 256) flush(keep, last);  // memory stays bounded (the walks then as undeferred)
-      Pending p{first, k_, t0, end, at, {}, turns && turn_count <= kMaxTurns ? turn_count : -1};
-      for (int i = 0; i < p.turn_count; ++i) p.turns[static_cast<std::size_t>(i)] = turns[i];
-      pending_.push_back(std::move(p));
+      pending_.push_back({first, k_, t0, end, at});
       return;
     }
     for (const Pending& p : pending_) r_.samples_left_out += p.end - p.first;
@@ -235,14 +229,18 @@ class TrajectoryRecorder {
     bool found = false;
     for (auto p = pending_.rbegin(); p != pending_.rend(); ++p) {
       const std::size_t before = kept_.size();
-      if (!found) found = walk_back(*p, keep, last);
+      for (long long k = p->end - 1; !found && k >= p->first; --k) {
+        const double t = static_cast<double>(k) * o_.sample_interval;
+        const HybridState h = k == p->end - 1 ? p->last : p->at(t - p->t0);
+        if (!keep(measured(p_, h))) continue;
+        kept_.push_back({t, h});
+        found = last(measured(p_, h));
+      }
       r_.samples_left_out += (p->end - p->first) - static_cast<long long>(kept_.size() - before);
     }
     pending_.clear();
     for (auto it = kept_.rbegin(); it != kept_.rend(); ++it) push(it->first, it->second);
   }
-  /// The most turns a pending segment keeps (defer_last_outside).
-  static constexpr int kMaxTurns = 8;
 
  private:
   void push(double t, double theta_o) {  // SimulationOptions::sample_theta_o_only
@@ -266,52 +264,8 @@ class TrajectoryRecorder {
     double t0;
     HybridState last;  // at(end − 1), already computed
     std::function<HybridState(double)> at;
-    std::array<double, kMaxTurns> turns;  // where θo may turn (defer_last_outside), ascending
-    int turn_count;                       // < 0: not known
   };
   std::vector<Pending> pending_;
-  // One pending segment's samples from its last backwards: those `keep` says may be outside are
-  // kept, down to the first that `last` says is certainly outside (then true).  Where its θo is
-  // monotone — from the last turn before a sample inside by the margin (or from the start) to that
-  // sample — the stretch holds no sample outside when θo at its start is inside by the margin too
-  // (the rule by which a whole segment is left out, ClosedFormRun::record); else its last sample
-  // that may be outside is found by bisection (the samples after it lie inside by the margin).
-  // The kept samples that may lie outside are those the sample-by-sample walk keeps.
-  template <class Keep, class Last>
-  bool walk_back(const Pending& p, const Keep& keep, const Last& last) {
-    const double h = o_.sample_interval;
-    auto state = [&](long long k) { return k == p.end - 1 ? p.last : p.at(static_cast<double>(k) * h - p.t0); };
-    for (long long k = p.end - 1; k >= p.first;) {
-      const HybridState x = state(k);
-      if (keep(measured(p_, x))) {
-        kept_.push_back({static_cast<double>(k) * h, x});
-        if (last(measured(p_, x))) return true;
-        --k;
-        continue;
-      }
-      const double tau = static_cast<double>(k) * h - p.t0;
-      double a = 0;  // the stretch's start: the last turn at or before τ, else the segment's start
-      for (int i = 0; i < p.turn_count; ++i)
-        if (p.turns[static_cast<std::size_t>(i)] <= tau) a = p.turns[static_cast<std::size_t>(i)];
-      if (p.turn_count < 0 || !(a <= tau)) {
-        --k;
-        continue;
-      }
-      long long first = k;  // the stretch's first sample
-      while (first > p.first && static_cast<double>(first - 1) * h - p.t0 >= a) --first;
-      if (!keep(measured(p_, p.at(a)))) {
-        k = first - 1;
-        continue;
-      }
-      long long lo = first - 1, hi = k;  // keep at lo (or at a), not at hi
-      while (hi - lo > 1) {
-        const long long mid = lo + (hi - lo) / 2;
-        (keep(measured(p_, state(mid))) ? lo : hi) = mid;
-      }
-      k = lo;
-    }
-    return false;
-  }
 };
 
 /// The state with the measured shaft at θo, both shafts moving at `velocity`, and the
