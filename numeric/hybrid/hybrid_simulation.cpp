@@ -150,7 +150,7 @@ class Flight {
   }
   SmallVector vector(double tau) const { return gap_sample(tau, false).x; }
   /// x(τ) and the gap change Δx(τ): one closed-form evaluation (`with_gap` false: x alone).
-  [[gnu::always_inline]] WitnessSample gap_sample(double tau, bool with_gap = true) const {
+  WitnessSample gap_sample(double tau, bool with_gap = true) const {
     if (linear_) {
       WitnessSample s{linear_->state(tau), 0};
       if (with_gap) {
@@ -346,7 +346,7 @@ class ClosedFormRun {
     result_.stop_reason = std::move(reason);
     return finish(status);
   }
-  [[gnu::always_inline]] void push_event(EventKind kind, bool bounce, bool grazing) {
+  void push_event(EventKind kind, bool bounce, bool grazing) {
     SimulationEvent e;
     e.t = t_;
     e.kind = kind;
@@ -503,7 +503,7 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
   const Flight flight = from_line ? Flight::from_separation_line(evaluator_, state_) : Flight::from_state(p_, state_);
   const auto at = [flight](double tau) { return flight.at(tau); };  // a copy: record() may keep it
   const double scale = std::max({1.0, std::fabs(theta_o), std::fabs(swept_angle(constants_->time_unit, state_.dtheta_m))});
-  const auto sample = [&flight](double tau) __attribute__((always_inline)) { return flight.gap_sample(tau); };
+  const auto sample = [&flight](double tau) { return flight.gap_sample(tau); };
   // Δx'(0) = 0 exactly: the separation line's closed form starts both bodies at one velocity.
   const bool turns_once = constants_->gap_turns_once && (from_line || state_.dtheta_m == state_.dtheta_L);
   const auto event = start_gap_ ? detail::first_gap_event_inside_with(gap_mode_, sample, *start_gap_, state_.face,
