@@ -195,8 +195,12 @@ struct HeatImage {
 // The column of each cell [low, high] on a uniform grid of at least 2 columns from min(low)
 // to max(high), within rounding (1e-6 of a column); the number of columns; nothing if the
 // cells do not form one.
-std::optional<std::pair<std::vector<std::size_t>, std::size_t>> uniform_columns(const std::vector<double>& low,
-                                                                                const std::vector<double>& high) {
+struct UniformColumns {
+  std::vector<std::size_t> column;  // of each cell
+  std::size_t count = 0;
+  double from = 0, step = 0;  // the grid's first edge and its column width
+};
+std::optional<UniformColumns> uniform_columns(const std::vector<double>& low, const std::vector<double>& high) {
   if (low.empty()) return std::nullopt;
   const double from = *std::min_element(low.begin(), low.end()), to = *std::max_element(high.begin(), high.end());
   const double width = high[0] - low[0], columns = std::round((to - from) / width);
@@ -210,7 +214,7 @@ std::optional<std::pair<std::vector<std::size_t>, std::size_t>> uniform_columns(
       return std::nullopt;
     column[k] = static_cast<std::size_t>(i);
   }
-  return std::pair{std::move(column), static_cast<std::size_t>(columns)};
+  return UniformColumns{std::move(column), static_cast<std::size_t>(columns), from, step};
 }
 
 std::optional<HeatImage> heat_image(const Plot& plot) {
@@ -223,16 +227,14 @@ std::optional<HeatImage> heat_image(const Plot& plot) {
       value.push_back(h.value[k]);
     }
   const auto columns = uniform_columns(x_low, x_high), rows = uniform_columns(y_low, y_high);
-  if (!columns || !rows || columns->second * rows->second > 4 * value.size()) return std::nullopt;  // at most 4 pixels per cell
+  if (!columns || !rows || columns->count * rows->count > 4 * value.size()) return std::nullopt;  // at most 4 pixels per cell
   HeatImage image;
-  image.nx = columns->second, image.ny = rows->second;
-  image.x0 = *std::min_element(x_low.begin(), x_low.end());
-  image.dx = (*std::max_element(x_high.begin(), x_high.end()) - image.x0) / static_cast<double>(image.nx);
-  image.y0 = *std::min_element(y_low.begin(), y_low.end());
-  image.dy = (*std::max_element(y_high.begin(), y_high.end()) - image.y0) / static_cast<double>(image.ny);
+  image.nx = columns->count, image.ny = rows->count;
+  image.x0 = columns->from, image.dx = columns->step;
+  image.y0 = rows->from, image.dy = rows->step;
   image.pixel.assign(image.nx * image.ny, std::numeric_limits<double>::quiet_NaN());
   for (std::size_t k = 0; k < value.size(); ++k) {
-    double& pixel = image.pixel[columns->first[k] + image.nx * rows->first[k]];
+    double& pixel = image.pixel[columns->column[k] + image.nx * rows->column[k]];
     if (!std::isnan(pixel)) return std::nullopt;  // a cell twice
     pixel = value[k];
   }
