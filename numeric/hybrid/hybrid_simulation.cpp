@@ -149,6 +149,8 @@ class Flight {
     return detail::damped_turns(p.Fm / (2 * p.Jm), p.K / p.Jm, evaluator_->cot_phi() * v_, v_, duration, out, capacity);
   }
   SmallVector vector(double tau) const { return gap_sample(tau, false).x; }
+  /// What at(τ).θm adds to the closed form's own θm (the separation line's frame to the run's).
+  double motor_offset() const { return offset_m_; }
   /// x(τ) and the gap change Δx(τ): one closed-form evaluation (`with_gap` false: x alone).
   WitnessSample gap_sample(double tau, bool with_gap = true) const {
     if (linear_) {
@@ -572,9 +574,14 @@ std::optional<std::string> ClosedFormRun::unresolved_return(const detail::GapEve
 }
 
 // Rest: the event at the last time any velocity exceeded the tolerance (bisection on the
-// closed form), then the state at t_end.
+// closed form, its points after a certified quiet state not evaluated: rest_search.hpp), then
+// the state at t_end.
 SimulationStatus ClosedFormRun::rest(const Flight& flight, double remaining, const HybridState& end) {
-  const double hi = detail::rest_time([&](double t) { return flight.at(t); }, remaining, o_.rest_velocity);
+  const detail::FreeFlightRestBound bound(constants_->free_segment);
+  const auto quiet_after = [&](const HybridState& s) {
+    return bound.quiet_after(s.theta_m - flight.motor_offset(), s.dtheta_m, s.dtheta_L, o_.rest_velocity);
+  };
+  const double hi = detail::rest_time([&](double t) { return flight.at(t); }, remaining, o_.rest_velocity, quiet_after);
   const double t_end = t_ + remaining;
   t_ += hi;
   state_ = flight.at(hi);

@@ -65,18 +65,6 @@ struct MotorBlock {
   }
 };
 
-// Whether A, c have the free mode's form (segment_dynamics.cpp, free_mode_segment), its rates ≥ 0.
-bool free_mode_form(const SmallMatrix& A, const SmallVector& c) {
-  if (A.rows() != 4 || A.cols() != 4 || c.size() != 4) return false;
-  const bool fixed_rows = A(0, 0) == 0 && A(0, 1) == 1 && A(0, 2) == 0 && A(0, 3) == 0 && A(1, 3) == 0 &&
-                          A(2, 0) == 0 && A(2, 1) == 0 && A(2, 2) == 0 && A(2, 3) == 1 && A(3, 0) == 0 &&
-                          A(3, 1) == 0 && A(3, 2) == 0 && c(0) == 0 && c(2) == 0 && c(3) == 0;
-  bool finite = true;  // (a loop: Eigen's allFinite on these dynamic sizes costs hundreds of instructions)
-  for (int i = 0; i < 16; ++i) finite = finite && std::isfinite(A.data()[i]);
-  for (int i = 0; i < 4; ++i) finite = finite && std::isfinite(c.data()[i]);
-  return fixed_rows && A(1, 0) <= 0 && A(1, 1) <= 0 && A(1, 2) <= 0 && A(3, 3) <= 0 && finite;
-}
-bool free_mode_form(const LinearSegment& s) { return free_mode_form(s.A, s.c); }
 
 // The gap change Δx(τ) = (θL − θm)(τ) − (θL − θm)(0) of the flight through x0 = x(0), for
 // τ ≥ τ0, within [low, high] (docs/design.md, "The event loop": a quiet tail).  With the motor not
@@ -100,6 +88,18 @@ struct GapTail {
 };
 
 }  // namespace
+
+bool free_mode_form(const SmallMatrix& A, const SmallVector& c) {
+  if (A.rows() != 4 || A.cols() != 4 || c.size() != 4) return false;
+  const bool fixed_rows = A(0, 0) == 0 && A(0, 1) == 1 && A(0, 2) == 0 && A(0, 3) == 0 && A(1, 3) == 0 &&
+                          A(2, 0) == 0 && A(2, 1) == 0 && A(2, 2) == 0 && A(2, 3) == 1 && A(3, 0) == 0 &&
+                          A(3, 1) == 0 && A(3, 2) == 0 && c(0) == 0 && c(2) == 0 && c(3) == 0;
+  bool finite = true;  // (a loop: Eigen's allFinite on these dynamic sizes costs hundreds of instructions)
+  for (int i = 0; i < 16; ++i) finite = finite && std::isfinite(A.data()[i]);
+  for (int i = 0; i < 4; ++i) finite = finite && std::isfinite(c.data()[i]);
+  return fixed_rows && A(1, 0) <= 0 && A(1, 1) <= 0 && A(1, 2) <= 0 && A(3, 3) <= 0 && finite;
+}
+bool free_mode_form(const LinearSegment& s) { return free_mode_form(s.A, s.c); }
 
 double quiet_gap_from(const SmallMatrix& A, const SmallVector& c, const SmallVector& x0, double level_a,
                       double level_b, double horizon, double first_window) {

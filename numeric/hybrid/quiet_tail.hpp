@@ -25,6 +25,11 @@
 
 namespace backlash::numeric::detail {
 
+/// Whether A, c have the free mode's form (segment_dynamics.cpp, free_mode_segment), finite, its
+/// rates ≥ 0 (−A(1, 0), −A(1, 1), −A(1, 2), −A(3, 3)).
+bool free_mode_form(const SmallMatrix& A, const SmallVector& c);
+bool free_mode_form(const LinearSegment& s);
+
 /// The bound above on sup |d⁴/dt⁴ (θL − θm)| over [a, b] ⊂ [T, ∞) (b − a, a ≥ T in s) for the
 /// flight of `free_segment` (free_mode_segment) through the state `xT` = (θm, θ̇m, θL, θ̇L) at T,
 /// its rounding allowed for (the derivatives at T are formed from xT: a relative 1e-6 of their
