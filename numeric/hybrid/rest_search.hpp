@@ -75,12 +75,17 @@ struct FreeFlightRestBound {
     return std::max(motor, std::fabs(dtheta_L));
   }
 
-  /// Whether every later velocity is below rest_velocity by a factor of 2: the closed form's values
-  /// there (which rest_time compares) differ from the exact flight through this state by its
-  /// rounding, relative to the decayed velocities' size — far inside the other half.  θm is the
-  /// closed form's own, in the frame of the segment's c (without an offset added after it).
+  /// The share of rest_velocity the bound must stay below: the closed form's values at the later
+  /// points (which rest_time compares) differ from the exact flight through this state by their
+  /// rounding — ulps of the decayed terms, ≥ 1e13 times less than the other tenth; an absolute
+  /// floor of rounding (ulps of the angles) is below the bound's own rate term, 1e-12·√k·|θm|.
+  static constexpr double margin = 0.9;
+
+  /// Whether every later velocity is certified below rest_velocity (velocity_bound < margin ×
+  /// rest_velocity).  θm is the closed form's own, in the frame of the segment's c (without an
+  /// offset added after it).
   bool quiet_after(double theta_m, double dtheta_m, double dtheta_L, double rest_velocity) const {
-    return usable && velocity_bound(theta_m, dtheta_m, dtheta_L) < 0.5 * rest_velocity;
+    return usable && velocity_bound(theta_m, dtheta_m, dtheta_L) < margin * rest_velocity;
   }
 };
 
