@@ -281,9 +281,7 @@ HybridState rigid_start(const Parameters& p, const HybridState& start) {
 namespace {
 
 // A sample band (SimulationOptions::sample_band) in a run's frame, and its margin.
-struct Band {
-  double low, high, margin;
-};
+using Band = TrajectoryRecorder::BandTest;
 
 // One run of the closed-form hybrid automaton from a start state: contact segments (the
 // validated closed form, separation at the first certified zero of Tc) and free flights (the
@@ -371,11 +369,12 @@ class ClosedFormRun {
   std::optional<std::string> unresolved_return(const detail::GapEvent& event) const;
   template <class At>
   void record(double upto, const At& at, FunctionRef<int(double, double*, int)> turns);
-  // θo perhaps outside the sample band (not inside by the margin), and certainly outside (by it).
-  bool keep_sample(double o) const { return !(o >= band_->low + band_->margin && o <= band_->high - band_->margin); }
-  bool last_sample(double o) const { return o < band_->low - band_->margin || o > band_->high + band_->margin; }
+  template <class At>
+  [[gnu::noinline]] void record_in_band(double upto, const At& at, FunctionRef<int(double, double*, int)> turns);
+  // θo perhaps outside the sample band (not inside it by the margin: BandTest).
+  bool keep_sample(double o) const { return band_->may_be_outside(o); }
   void flush_samples() {
-    if (band_) recorder_.flush([this](double o) { return keep_sample(o); }, [this](double o) { return last_sample(o); });
+    if (band_) recorder_.flush(*band_);
   }
 
   const ValidatedEvaluator& evaluator_;
@@ -547,14 +546,19 @@ std::optional<SimulationStatus> ClosedFormRun::flight() {
 template <class At>
 void ClosedFormRun::record(double upto, const At& at, FunctionRef<int(double, double*, int)> turns) {
   if (!band_) return recorder_.record(t_, upto, at);
+  record_in_band(upto, at, turns);
+}
+
+// record() with a sample band: out of line, so that the event loop compiles as without it (issue 19).
+template <class At>
+void ClosedFormRun::record_in_band(double upto, const At& at, FunctionRef<int(double, double*, int)> turns) {
   const auto keep = [this](double o) { return keep_sample(o); };
-  const auto last = [this](double o) { return last_sample(o); };
-  std::array<double, 8> times;
+  std::array<double, TrajectoryRecorder::kMaxTurns> times;
   const int count = turns(upto - t_, times.data(), static_cast<int>(times.size()));
   bool skip = count >= 0 && !keep(measured(p_, at(0))) && !keep(measured(p_, at(upto - t_)));
   for (int i = 0; skip && i < count; ++i) skip = !keep(measured(p_, at(times[i])));
   if (skip) recorder_.skip(upto);
-  else recorder_.defer_last_outside(t_, upto, at, keep, last);  // `at` kept by value: it owns its segment
+  else recorder_.defer_last_outside(t_, upto, at, *band_, times.data(), count);  // `at` kept by value: it owns its segment
 }
 
 // A return to the face just left, found within the search's resolution of the certified

@@ -29,6 +29,7 @@
 
 #include "backlash/numeric/validation.hpp"
 
+#include <array>
 #include <cmath>
 #include <functional>
 #include <optional>
@@ -197,50 +198,44 @@ class TrajectoryRecorder {
     if (o_.sample_interval <= 0) return;
     for (; static_cast<double>(k_) * o_.sample_interval <= t_upto; ++k_) ++r_.samples_left_out;
   }
+  /// The test of SimulationOptions::sample_band in a run's frame: θo in [low, high], decided
+  /// only outside a `margin` about its edges (hybrid_simulation.hpp, SampleBand).
+  struct BandTest {
+    double low, high, margin;
+    /// θo perhaps outside the band: not inside it by the margin (a sample to keep).
+    bool may_be_outside(double theta_o) const { return !(theta_o >= low + margin && theta_o <= high - margin); }
+    /// θo certainly outside the band: outside it by the margin (no earlier sample is needed).
+    bool outside(double theta_o) const { return theta_o < low - margin || theta_o > high + margin; }
+  };
+  /// The most turns of θo a pending segment keeps (defer_last_outside).
+  static constexpr int kMaxTurns = 8;
   /// record() for a caller that needs only the last θo outside a band (SimulationOptions::sample_band):
-  /// the segment's samples from its last backwards, keeping those `keep(θo)` says may be outside
-  /// and stopping at the first `last(θo)` says is certainly outside; the kept ones are recorded in
-  /// time order, the others counted as left out.  Deferred (issue 19): only the last sample now;
-  /// the walk waits, `at` kept, until a later segment's last sample is certainly outside (then the
-  /// samples before it are not needed: all left out) or the run ends (flush).  With sample_times: record().
-  template <class At, class Keep, class Last>
-  void defer_last_outside(double t0, double t_upto, const At& at, const Keep& keep, const Last& last) {
+  /// the segment's samples from its last backwards, keeping those that may be outside
+  /// (BandTest::may_be_outside) and stopping at the first certainly outside (BandTest::outside);
+  /// the kept ones are recorded in time order, the others counted as left out.  Deferred (issue 19):
+  /// only the last sample now; the walk waits, `at` kept, until a later segment's last sample is
+  /// certainly outside (then the samples before it are not needed: all left out) or the run ends
+  /// (flush).  `turns`: the times τ in (0, t_upto − t0) where the segment's θo may turn, ascending
+  /// (`turn_count` of them, < 0: not known, or more than kMaxTurns): between them θo is monotone,
+  /// which the walk uses (walk_back).  With sample_times: record().
+  template <class At>
+  void defer_last_outside(double t0, double t_upto, const At& at, const BandTest& band, const double* turns = nullptr,
+                          int turn_count = -1) {
     if (!o_.sample_times.empty() || o_.sample_interval <= 0) return record(t0, t_upto, at);
     const long long first = k_;
     while (static_cast<double>(k_) * o_.sample_interval <= t_upto) ++k_;
     if (k_ == first) return;
     const double t = static_cast<double>(k_ - 1) * o_.sample_interval;
     const HybridState end = at(t - t0);
-    if (!last(measured(p_, end))) {
-      if (pending_.size() >= 256) flush(keep, last);  // memory stays bounded (the walks then as undeferred)
-      pending_.push_back({first, k_, t0, end, at});
-      return;
-    }
+    if (!band.outside(measured(p_, end))) return defer(first, t0, end, at, band, turns, turn_count);
     for (const Pending& p : pending_) r_.samples_left_out += p.end - p.first;
     pending_.clear();
     r_.samples_left_out += k_ - 1 - first;
-    if (keep(measured(p_, end))) push(t, end);
+    if (band.may_be_outside(measured(p_, end))) push(t, end);
   }
   /// The walks defer_last_outside left pending, newest first, to the first sample certainly
   /// outside; every one of the run's samples is then recorded or counted as left out.
-  template <class Keep, class Last>
-  void flush(const Keep& keep, const Last& last) {
-    kept_.clear();
-    bool found = false;
-    for (auto p = pending_.rbegin(); p != pending_.rend(); ++p) {
-      const std::size_t before = kept_.size();
-      for (long long k = p->end - 1; !found && k >= p->first; --k) {
-        const double t = static_cast<double>(k) * o_.sample_interval;
-        const HybridState h = k == p->end - 1 ? p->last : p->at(t - p->t0);
-        if (!keep(measured(p_, h))) continue;
-        kept_.push_back({t, h});
-        found = last(measured(p_, h));
-      }
-      r_.samples_left_out += (p->end - p->first) - static_cast<long long>(kept_.size() - before);
-    }
-    pending_.clear();
-    for (auto it = kept_.rbegin(); it != kept_.rend(); ++it) push(it->first, it->second);
-  }
+  void flush(const BandTest& band);
 
  private:
   void push(double t, double theta_o) {  // SimulationOptions::sample_theta_o_only
@@ -264,8 +259,17 @@ class TrajectoryRecorder {
     double t0;
     HybridState last;  // at(end − 1), already computed
     std::function<HybridState(double)> at;
+    std::array<double, kMaxTurns> turns;  // where θo may turn (defer_last_outside), ascending
+    int turn_count;                       // < 0: not known
   };
   std::vector<Pending> pending_;
+  // The segment's samples [first, k_) made pending (out of line, with walk_back: the closed-form
+  // event loop's code is not the band's, issue 19).
+  [[gnu::noinline]] void defer(long long first, double t0, const HybridState& last, std::function<HybridState(double)> at,
+                               const BandTest& band, const double* turns, int turn_count);
+  // One pending segment's samples from its last backwards (trajectory_recorder.cpp); true at the
+  // first certainly outside.
+  bool walk_back(const Pending& p, const BandTest& band);
 };
 
 /// The state with the measured shaft at θo, both shafts moving at `velocity`, and the
