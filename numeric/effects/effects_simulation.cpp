@@ -280,32 +280,30 @@ namespace {
 // The closed-form samples of one segment, shared by its witnesses' searches: every witness is
 // searched over the same windows, each search's windows start where its last one ended, and the
 // first window is the mode's own (WitnessMode::first_window: A alone), so the same τ is asked for
-// again and again.  The last few evaluations are kept and given again (an exact match of τ's bits:
-// the same τ gives the same bits).
+// again and again.  Evaluations are kept and given again (an exact match of τ's bits: the same τ
+// gives the same bits), each in the slot its τ's bits hash to (one comparison per look-up; a
+// later τ with the same slot replaces it, which costs only an evaluation again).
 class SampleMemo {
  public:
   explicit SampleMemo(const ModeFlow& flow) : flow_(flow) {}
   const SmallVector& local(double tau) const {
     std::uint64_t key;
     std::memcpy(&key, &tau, sizeof key);
-    for (int k = 1, i = next_; k <= size_; ++k) {  // the newest first: most repeats are of the last few
-      i = i == 0 ? capacity - 1 : i - 1;
-      if (keys_[i] == key) return z_[i];
-    }
-    const int at = next_;
-    next_ = (next_ + 1) % capacity;
-    size_ = std::max(size_, next_ == 0 ? capacity : next_);
+    const auto at = static_cast<unsigned>(((key ^ (key >> 32)) * 0x9E3779B97F4A7C15ull) >> (64 - bits));
+    const unsigned bit = 1u << at;
+    if ((filled_ & bit) && keys_[at] == key) return z_[at];
+    filled_ |= bit;
     keys_[at] = key;
     z_[at] = flow_.local(tau);
     return z_[at];
   }
 
  private:
-  static constexpr int capacity = 16;
+  static constexpr int bits = 5, capacity = 1 << bits;
   const ModeFlow& flow_;
-  mutable std::array<std::uint64_t, capacity> keys_{};
+  mutable std::array<std::uint64_t, capacity> keys_;
   mutable std::array<SmallVector, capacity> z_;
-  mutable int size_ = 0, next_ = 0;
+  mutable unsigned filled_ = 0;  // the slots that hold an evaluation
 };
 
 // The certified search for one witness's first exit, advanced window by window.
