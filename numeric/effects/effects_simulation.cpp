@@ -47,12 +47,14 @@ double factorial(int n) { return n <= 1 ? 1.0 : n * factorial(n - 1); }
 // rounding noise is positive): the largest τ0 = horizon/2^i where the Taylor lower bound
 //   w(τ) ≥ w_K τ^K/K! − Σ_{j<K} |w_j| τ^j/j! − sup|w^{(K+1)}| τ^{K+1}/(K+1)!
 // is positive, sup|w^{(K+1)}| ≤ ‖e A^K‖₁ e^{‖A‖τ} ‖ż(0)‖∞.  0 when none is found.
-double departure_time(const SmallMatrix& A, const SmallRow& e, const SmallVector& zdot0, const std::array<double, 4>& w,
-                      int K, double horizon) {
-  SmallRow eAK = e;
-  for (int k = 0; k < K; ++k) eAK = eAK * A;
-  const double norm_A = A.cwiseAbs().rowwise().sum().maxCoeff(), norm_z = zdot0.cwiseAbs().maxCoeff();
-  const double norm_eAK = eAK.cwiseAbs().sum();
+// e A^K and ‖A‖∞ are the witness's mode's own (WitnessMode: eA = e·A, eA2 = eA·A, eA3 = eA2·A and
+// ‖A‖∞ formed as here, the same bits), not formed again per departure.
+double departure_time(const WitnessMode& mode, const SmallVector& zdot0, const std::array<double, 4>& w, int K,
+                      double horizon) {
+  const std::array<const SmallRow*, 4> rows{&mode.e, &mode.eA, &mode.eA2, &mode.eA3};  // e A^K
+  const SmallRow& eAK = *rows[static_cast<std::size_t>(K)];
+  const double norm_A = mode.norm_A_plain, norm_z = zdot0.cwiseAbs().maxCoeff();
+  const double norm_eAK = K == 1 ? mode.norm_eA : eAK.cwiseAbs().sum();
   double tau = horizon;
   int i = 0;
   // The remainder's term alone (e^{‖A‖τ} ≥ 1) is at least twice the leading one, so the bound is
@@ -97,6 +99,30 @@ struct Start {
   bool departs = false;  ///< on the boundary, leaving toward w > 0, certified w(from) > 0 (departure_time)
 };
 
+// The start's rate ż(0) = A z0 + c, the same for every witness of a segment, and the size of the
+// terms that form it, |A|(|z0| + z0's rounding) + c's terms (its rounding scale): formed once per
+// segment, the latter only when a witness starts on its boundary (classify_start).
+class StartRates {
+ public:
+  explicit StartRates(const ModeFlow& flow)
+      : flow_(flow), zdot_(flow.segment().A * flow.local_start() + flow.segment().c) {}
+  const SmallVector& zdot() const { return zdot_; }
+  const SmallVector& scale() const {
+    if (!scaled_) {
+      scale_ = flow_.segment().A.cwiseAbs() * (flow_.local_start().cwiseAbs() + flow_.local_start_noise()) +
+               flow_.forcing_magnitude();
+      scaled_ = true;
+    }
+    return scale_;
+  }
+
+ private:
+  const ModeFlow& flow_;
+  SmallVector zdot_;
+  mutable SmallVector scale_;
+  mutable bool scaled_ = false;
+};
+
 // Where the search for a witness's exit starts.  Rounding scales come from the size of the
 // terms that formed each quantity (a deviation or a forcing can cancel): w(0) is on its
 // boundary when within the rounding of its terms, or within what the previous event's time
@@ -106,12 +132,13 @@ struct Start {
 // an exit at once, entering it starts the search after a certified departure time.
 // The witness's mode holds eᵀA, eᵀA² (the products formed here, the same bits), so they are not
 // formed again; the higher derivatives and their rounding scales only on the boundary.
-// `zdot` = A z0 + c, the start's rate, the same for every witness of the segment.
-Start classify_start(const ModeFlow& flow, const WitnessMode& mode, double level, const SmallVector& zdot,
+// `rates`: the start's rate and its rounding scale, the same for every witness of the segment.
+// w^{(K)} and its scale are formed for K up to the first that decides (the same bits as all of them).
+Start classify_start(const ModeFlow& flow, const WitnessMode& mode, double level, const StartRates& rates,
                      double magnitude, double horizon, double t_global) {
+  const SmallVector& zdot = rates.zdot();
   const SmallVector& z0 = flow.local_start();
   const SmallVector& z0_noise = flow.local_start_noise();
-  const SmallMatrix& A = mode.A;
   const SmallRow& e = mode.e;
   std::array<double, 4> w{};
   w[0] = dot(e, z0) - level;
@@ -121,19 +148,13 @@ Start classify_start(const ModeFlow& flow, const WitnessMode& mode, double level
                            std::fabs(w[1]) * 4e-14 * std::max(1.0, std::fabs(t_global));
   if (w[0] > tolerance) return {StartKind::Inside, 0};
   if (w[0] < -tolerance) return {StartKind::ExitNow, 0};
-  const SmallVector zdot_scale = A.cwiseAbs() * (z0.cwiseAbs() + z0_noise) + flow.forcing_magnitude();
-  const SmallRow& eA = mode.eA;
-  const SmallRow& eA2 = mode.eA2;
-  const std::array<const SmallRow*, 4> rows{nullptr, &e, &eA, &eA2};  // e A^{k−1} for w^{(k)}
-  std::array<double, 4> scale{};
-  for (int k = 1; k <= 3; ++k) {
-    if (k > 1) w[k] = rows[k]->dot(zdot);
-    scale[k] = rows[k]->cwiseAbs().dot(zdot_scale.transpose());
-  }
+  const std::array<const SmallRow*, 4> rows{nullptr, &e, &mode.eA, &mode.eA2};  // e A^{k−1} for w^{(k)}
   for (int K = 1; K <= 3; ++K) {
-    if (std::fabs(w[K]) <= 1e-9 * scale[K]) continue;
+    if (K > 1) w[K] = rows[K]->dot(zdot);
+    const double scale = rows[K]->cwiseAbs().dot(rates.scale().transpose());
+    if (std::fabs(w[K]) <= 1e-9 * scale) continue;
     if (w[K] < 0) return {StartKind::ExitNow, 0};
-    const double from = departure_time(A, e, zdot, w, K, horizon);
+    const double from = departure_time(mode, zdot, w, K, horizon);
     if (from > 0) return {StartKind::Inside, from, true};
     return {StartKind::Inside, std::min(horizon, 1e-12 * std::max(1.0, horizon))};
   }
@@ -259,38 +280,36 @@ namespace {
 // The closed-form samples of one segment, shared by its witnesses' searches: every witness is
 // searched over the same windows, each search's windows start where its last one ended, and the
 // first window is the mode's own (WitnessMode::first_window: A alone), so the same τ is asked for
-// again and again.  The last few evaluations are kept and given again (an exact match of τ's bits:
-// the same τ gives the same bits).
+// again and again.  Evaluations are kept and given again (an exact match of τ's bits: the same τ
+// gives the same bits), each in the slot its τ's bits hash to (one comparison per look-up; a
+// later τ with the same slot replaces it, which costs only an evaluation again).
 class SampleMemo {
  public:
   explicit SampleMemo(const ModeFlow& flow) : flow_(flow) {}
   const SmallVector& local(double tau) const {
     std::uint64_t key;
     std::memcpy(&key, &tau, sizeof key);
-    for (int k = 1, i = next_; k <= size_; ++k) {  // the newest first: most repeats are of the last few
-      i = i == 0 ? capacity - 1 : i - 1;
-      if (keys_[i] == key) return z_[i];
-    }
-    const int at = next_;
-    next_ = (next_ + 1) % capacity;
-    size_ = std::max(size_, next_ == 0 ? capacity : next_);
+    const auto at = static_cast<unsigned>(((key ^ (key >> 32)) * 0x9E3779B97F4A7C15ull) >> (64 - bits));
+    const unsigned bit = 1u << at;
+    if ((filled_ & bit) && keys_[at] == key) return z_[at];
+    filled_ |= bit;
     keys_[at] = key;
     z_[at] = flow_.local(tau);
     return z_[at];
   }
 
  private:
-  static constexpr int capacity = 16;
+  static constexpr int bits = 5, capacity = 1 << bits;
   const ModeFlow& flow_;
-  mutable std::array<std::uint64_t, capacity> keys_{};
+  mutable std::array<std::uint64_t, capacity> keys_;
   mutable std::array<SmallVector, capacity> z_;
-  mutable int size_ = 0, next_ = 0;
+  mutable unsigned filled_ = 0;  // the slots that hold an evaluation
 };
 
 // The certified search for one witness's first exit, advanced window by window.
 class ExitSearch {
  public:
-  ExitSearch(const Parameters& p, const ModeFlow& flow, const SampleMemo& memo, const SmallVector& zdot,
+  ExitSearch(const Parameters& p, const ModeFlow& flow, const SampleMemo& memo, const StartRates& rates,
              std::uint64_t group, const Witness& witness, double horizon, double t_global)
       : p_(p), flow_(flow), memo_(memo), witness_(witness) {
     level_ = -witness.f.constant;
@@ -300,7 +319,7 @@ class ExitSearch {
     // built again for each window of each witness (issue 19: the mesh's searches).
     bound_ = flow.derivative_bound(witness.f.row, 3);
     mode_ = &detail::kept_witness_mode(group, flow.segment().A, flow.segment().c, witness.f.row);
-    const Start start = classify_start(flow, *mode_, level_, zdot, witness.f.magnitude, horizon, t_global);
+    const Start start = classify_start(flow, *mode_, level_, rates, witness.f.magnitude, horizon, t_global);
     if (start.kind == StartKind::Never) finished_ = true;
     if (start.kind == StartKind::ExitNow) immediate_ = true;
     from_ = start.from;
@@ -429,11 +448,11 @@ class ClosedFormSegment final : public detail::Segment {
     detail::mode_witnesses(p, e, m, functionals_of(p, e, flow_, left_zone), true, witnesses);
     witnesses.insert(witnesses.end(), extra.begin(), extra.end());
     const SampleMemo memo(flow_);
-    const SmallVector zdot = flow_.segment().A * flow_.local_start() + flow_.segment().c;  // ż(0)
+    const StartRates rates(flow_);  // ż(0), and its rounding scale when a witness starts on its boundary
     searches.reserve(witnesses.size());
     const std::uint64_t group = detail::kept_mode_group(flow_.segment().A);  // the witnesses' A, compared once
     for (const Witness& w : witnesses) {
-      searches.emplace_back(p, flow_, memo, zdot, group, w, horizon, t_global);
+      searches.emplace_back(p, flow_, memo, rates, group, w, horizon, t_global);
       if (searches.back().immediate()) {
         duration = 0;
         if (w.guard != Guard::Handover) exit = Exit{0, w, false};  // a handover at once: an empty segment
