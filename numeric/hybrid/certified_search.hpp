@@ -64,16 +64,34 @@ template <int N>
   else return r[0] * x[0] + r[1] * x[1];
 }
 
-// z = A x + c (x' at x) into z; returns ‖x‖∞.  `A` column-major N × N (Eigen's storage).
+// z = A x + c (x' at x) into z; returns ‖x‖∞.  `A` column-major N × N (Eigen's storage).  Each
+// z_i sums its row's products left to right, then adds c_i; two rows at a time in one vector
+// register where the compiler has them (the same operations on each lane: the same bits).
 template <int N>
 [[gnu::always_inline]] inline double rate_of(const double* A, const double* c, const double* x, double* z) {
+#if defined(__GNUC__)
+  if constexpr (N % 2 == 0) {
+    typedef double Pair __attribute__((vector_size(16)));
+    const auto load = [](const double* p) {
+      Pair v;
+      std::memcpy(&v, p, sizeof v);
+      return v;
+    };
+    for (int i = 0; i < N; i += 2) {
+      Pair zi = load(A + i) * x[0];
+      for (int j = 1; j < N; ++j) zi += load(A + i + N * j) * x[j];
+      zi += load(c + i);
+      std::memcpy(z + i, &zi, sizeof zi);
+    }
+  } else
+#endif
+    for (int i = 0; i < N; ++i) {
+      double zi = A[i] * x[0];
+      for (int j = 1; j < N; ++j) zi += A[i + N * j] * x[j];
+      z[i] = zi + c[i];
+    }
   double size = 0;
-  for (int i = 0; i < N; ++i) {
-    double zi = A[i] * x[0];
-    for (int j = 1; j < N; ++j) zi += A[i + N * j] * x[j];
-    z[i] = zi + c[i];
-    size = std::max(size, std::fabs(x[i]));
-  }
+  for (int i = 0; i < N; ++i) size = std::max(size, std::fabs(x[i]));
   return size;
 }
 template <int N>
@@ -312,7 +330,8 @@ std::optional<Crossing> search(const Sampler<F>& W, const std::function<double(d
         end.known = true;
       }
       if (!std::isfinite(a.w) || (!halve && !std::isfinite(b.w))) throw std::runtime_error("first_crossing: non-finite witness");
-      if (a.w == 0 && a.t > t_begin) return Crossing{a.t, false, examined};
+      // (a is never a root after t_begin: it is t_begin's sample or a right end passed on, and an
+      // end is passed on only without a sign change, so with w ≠ 0 there.)
       if (halve) {
         ends.push_back({lazy(a.t + 0.5 * h), false});
         continue;
