@@ -383,8 +383,7 @@ ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const H
   if (m.kind == ModeKind::Contact) {
     if (m.slip_motor != 0 && m.regime == 0) {
       y_star_ = (drive_constant(e, 0) - T * m.slip_motor) / p.K;
-      alpha_ = F / (2 * J);
-      w2_ = p.K / J;
+      contact_rates_ = damped_rates(F / (2 * J), p.K / J);
     } else if (m.slip_motor != 0) {
       beta_ = F / J;
       g_ = segment_.c(1);
@@ -409,8 +408,7 @@ ModeFlow::ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const H
   } else if (at_motor(p)) {
     motor_form_ = 2;  // its own closed loop
     y_star_ = (drive_constant(e, 0) - e.coulomb_motor * m.slip_motor) / p.K;
-    alpha_m_ = p.Fm / (2 * p.Jm);
-    w2_m_ = p.K / p.Jm;
+    motor_rates_ = damped_rates(p.Fm / (2 * p.Jm), p.K / p.Jm);
     motor_y0_ = measured(p, start) - p.theta_R - y_star_;
   } else {
     motor_form_ = 3;  // driven by the moving load
@@ -465,9 +463,9 @@ CoupledKernels ModeFlow::node_kernels(double x, double y, bool motor, bool load)
       break;
     case 2: {
       const double y0 = motor_y0_;
-      const DampedPair dp = damped_pair(alpha_m_, w2_m_, tau);
-      z0 = y0 * (dp.c - 1) + (vm0 + alpha_m_ * y0) * dp.s;
-      z1 = vm0 * dp.c - (alpha_m_ * vm0 + w2_m_ * y0) * dp.s;
+      const DampedPair dp = damped_pair(motor_rates_, tau);
+      z0 = y0 * (dp.c - 1) + (vm0 + motor_rates_.alpha * y0) * dp.s;
+      z1 = vm0 * dp.c - (motor_rates_.alpha * vm0 + motor_rates_.w2 * y0) * dp.s;
       break;
     }
     default:
@@ -485,9 +483,10 @@ SmallVector ModeFlow::local(double tau) const {
     if (m.slip_motor == 0) {
       z << 0, 0;
     } else if (m.regime == 0) {
-      const DampedPair dp = damped_pair(alpha_, w2_, tau);
+      const DampedPair dp = damped_pair(contact_rates_, tau);
       const double d0 = z0_(0), w0 = z0_(1);
-      z << d0 * dp.c + (w0 + alpha_ * d0) * dp.s, w0 * dp.c - (alpha_ * w0 + w2_ * d0) * dp.s;
+      const double alpha = contact_rates_.alpha, w2 = contact_rates_.w2;
+      z << d0 * dp.c + (w0 + alpha * d0) * dp.s, w0 * dp.c - (alpha * w0 + w2 * d0) * dp.s;
     } else {
       const double x = -beta_ * tau, w0 = z0_(1);
       const Phi12 f = phi12(x);

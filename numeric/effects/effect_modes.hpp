@@ -153,11 +153,13 @@ class ModeFlow {
   LinearSegment segment_;
   SmallVector z0_, z0_noise_, c_magnitude_;
   // closed-form constants
-  double alpha_ = 0, w2_ = 0, beta_ = 0, g_ = 0;  // contact
+  DampedRates contact_rates_;                      // contact: α = F/2J, w² = K/J (damped_rates)
+  double beta_ = 0, g_ = 0;                        // contact
   double y_star_ = 0;                              // contact / motor: equilibrium shift
   double theta_o_constant_ = 0;  // contact: theta_o_error().constant, formed once (state_of's, per sample)
   double motor_y0_ = 0;          // closed loop at the motor: θo0 − θR − y*, formed once (local's, per sample)
-  double a_ = 0, b_ = 0, k_ = 0, c0_ = 0, gL_ = 0, gm_ = 0, alpha_m_ = 0, w2_m_ = 0;  // free
+  double a_ = 0, b_ = 0, k_ = 0, c0_ = 0, gL_ = 0, gm_ = 0;  // free
+  DampedRates motor_rates_;  // free, closed loop at the motor: α = Fm/2Jm, w² = K/Jm
   int motor_form_ = 0;  // 0 stuck, 1 constant drive, 2 closed loop at the motor, 3 driven by the load
   std::shared_ptr<const Generic> generic_;
 };

@@ -110,10 +110,8 @@ StableSegments::StableSegments(const Parameters& p)
       k_(p.K / p.Jm),
       a_minus_b_(a_ - b_),
       gap_factor_(k_ - b_ * a_minus_b_),
-      alpha_m_(p.Fm / (2 * p.Jm)),
-      w2_m_(p.K / p.Jm),
-      alpha_c_((p.Fm + p.FL) / (2 * (p.Jm + p.JL))),
-      w2_c_(p.K / (p.Jm + p.JL)) {}
+      motor_(damped_rates(p.Fm / (2 * p.Jm), p.K / p.Jm)),
+      contact_(damped_rates((p.Fm + p.FL) / (2 * (p.Jm + p.JL)), p.K / (p.Jm + p.JL))) {}
 
 FreeState StableSegments::free_state(double t, double v0) const {
   FreeState s;
@@ -133,10 +131,10 @@ FreeState StableSegments::free_state(double t, double v0) const {
     s.theta_L = theta0 + v0 * t * phi1_y;
     s.dtheta_L = v0 * load.exp_x;
     const double e0 = theta0 - p_.theta_R;
-    const DampedPair q = damped_pair(alpha_m_, w2_m_, t);
-    const double e = e0 * q.c + (v0 + alpha_m_ * e0) * q.s;
+    const DampedPair q = damped_pair(motor_, t);
+    const double e = e0 * q.c + (v0 + motor_.alpha * e0) * q.s;
     s.theta_m = p_.theta_R + e;
-    s.dtheta_m = v0 * q.c - (alpha_m_ * v0 + w2_m_ * e0) * q.s;
+    s.dtheta_m = v0 * q.c - (motor_.alpha * v0 + motor_.w2 * e0) * q.s;
     // θL − θm = (θ0 − θR) + θ̇m0 t φ1(y) − e(t)
     s.gap = e0 + v0 * t * phi1_y - e;
   }
@@ -145,9 +143,9 @@ FreeState StableSegments::free_state(double t, double v0) const {
 
 ContactState StableSegments::contact_state(double t, double theta_o0, double dtheta_o0) const {
   const double e0 = theta_o0 - p_.theta_R;
-  const DampedPair q = damped_pair(alpha_c_, w2_c_, t);
-  return {p_.theta_R + e0 * q.c + (dtheta_o0 + alpha_c_ * e0) * q.s,
-          dtheta_o0 * q.c - (alpha_c_ * dtheta_o0 + w2_c_ * e0) * q.s};
+  const DampedPair q = damped_pair(contact_, t);
+  return {p_.theta_R + e0 * q.c + (dtheta_o0 + contact_.alpha * e0) * q.s,
+          dtheta_o0 * q.c - (contact_.alpha * dtheta_o0 + contact_.w2 * e0) * q.s};
 }
 
 FreeState free_state(const Parameters& p, double t, double v0) { return StableSegments(p).free_state(t, v0); }

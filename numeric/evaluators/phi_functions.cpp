@@ -118,9 +118,12 @@ void pair_series(double x, double y, double m, double& a1, double& a2) {
 
 }  // namespace
 
+namespace {
+
 // e^x, φ1(x), φ2(x): one Horner series (φ1 = 1 + xφ2, e^x = 1 + xφ1) for
 // |x| < 1/8; else expm1 and φ2 = (φ1 − 1)/x, which loses at most a factor 16.
-PhiPair phi_pair(double x) {
+// Inlined into the kernels below (their two nodes: no call, no returned struct).
+[[gnu::always_inline]] inline PhiPair phi_pair_of(double x) {
   const double ax = std::fabs(x);
   if (ax < 0.125) {
     const double phi2 = phi_series(2, x, series_terms(ax));
@@ -141,13 +144,17 @@ PhiPair phi_pair(double x) {
   return {e, phi1, (phi1 - 1.0) / x};
 }
 
+}  // namespace
+
+PhiPair phi_pair(double x) { return phi_pair_of(x); }
+
 ExpPhi1 exp_phi1(double x) {
-  const PhiPair p = phi_pair(x);
+  const PhiPair p = phi_pair_of(x);
   return {p.e, p.phi1};
 }
 
 LoadKernels load_kernels(double x, double y) {
-  const PhiPair px = phi_pair(x), py = phi_pair(y);
+  const PhiPair px = phi_pair_of(x), py = phi_pair_of(y);
   LoadKernels k{px.e, px.phi1, px.phi2, py.e, py.phi1, 0, 0};
   const double ax = std::fabs(x), ay = std::fabs(y);
   const double m = ax > ay ? ax : ay;
@@ -206,7 +213,7 @@ double phi3_from(double x, double phi2) {
 }  // namespace
 
 CoupledKernels coupled_kernels(double x, double y) {
-  const PhiPair px = phi_pair(x), py = phi_pair(y);
+  const PhiPair px = phi_pair_of(x), py = phi_pair_of(y);
   CoupledKernels k{px.e, px.phi1, px.phi2, py.e, py.phi1, py.phi2, 0, 0, 0};
   const double ax = std::fabs(x), ay = std::fabs(y);
   const double m = ax > ay ? ax : ay;
@@ -238,9 +245,21 @@ CoupledKernels coupled_kernels(double x, double y) {
   return k;
 }
 
-DampedPair damped_pair(double alpha, double w2, double t) {
-  const double D = alpha * alpha - w2;
-  const double z = D * t * t;
+DampedRates damped_rates(double alpha, double w2) {
+  DampedRates r;
+  r.alpha = alpha;
+  r.w2 = w2;
+  r.D = alpha * alpha - w2;
+  r.omega = std::sqrt(-r.D);  // NaN unless D ≤ 0, as √D is unless D ≥ 0: each is read only on its side
+  r.delta = std::sqrt(r.D);
+  r.fast = alpha + r.delta;
+  r.slow = w2 / r.fast;
+  return r;
+}
+
+DampedPair damped_pair(const DampedRates& r, double t) {
+  const double alpha = r.alpha;
+  const double z = r.D * t * t;
   if (std::fabs(z) <= 0.25) {
     // C = Σ z^k/(2k)!, S/t = Σ z^k/(2k+1)!
     double c = inverse_factorial[20], s = inverse_factorial[21];
@@ -252,19 +271,21 @@ DampedPair damped_pair(double alpha, double w2, double t) {
     return {decay * c, decay * s * t};
   }
   if (z < 0) {
-    const double omega = std::sqrt(-D);
+    const double omega = r.omega;
     const double decay = std::exp(-alpha * t);
     return {decay * std::cos(omega * t), decay * std::sin(omega * t) / omega};
   }
-  const double delta = std::sqrt(D);
+  const double delta = r.delta;
   if (delta * t <= 20.0) {
     const double decay = std::exp(-alpha * t);
     return {decay * std::cosh(delta * t), decay * std::sinh(delta * t) / delta};
   }
   // two real exponentials; the slow rate α − δ = w²/(α + δ) without cancellation
-  const double slow = std::exp(-(w2 / (alpha + delta)) * t);
-  const double fast = std::exp(-(alpha + delta) * t);
+  const double slow = std::exp(-r.slow * t);
+  const double fast = std::exp(-r.fast * t);
   return {0.5 * (slow + fast), 0.5 * (slow - fast) / delta};
 }
+
+DampedPair damped_pair(double alpha, double w2, double t) { return damped_pair(damped_rates(alpha, w2), t); }
 
 }  // namespace backlash::numeric

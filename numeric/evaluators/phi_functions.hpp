@@ -37,6 +37,8 @@
 // critical case is the limit, not a special formula.
 #pragma once
 
+#include "backlash/numeric/parametric.hpp"  // DampedRates
+
 namespace backlash::numeric {
 
 /// φ_n(x) = Σ_{j≥0} x^j/(j+n)!, n = 0…4 (accurate to a few ulps for x ≤ 0 and moderate x > 0).
@@ -87,5 +89,10 @@ struct DampedPair {
   double c, s;
 };
 DampedPair damped_pair(double alpha, double w2, double t);
+
+/// The parameter-only part of damped_pair(α, w², t), formed once: damped_pair(damped_rates(α, w²), t)
+/// is damped_pair(α, w², t) bit for bit (the same expressions in the same order).
+DampedRates damped_rates(double alpha, double w2);
+DampedPair damped_pair(const DampedRates& rates, double t);
 
 }  // namespace backlash::numeric

@@ -73,6 +73,13 @@ BranchSelection select_branches(const Parameters& p);
 /// cot φ = (Jm·FL − Fm·JL)/(K·JL).
 double cot_phi(const Parameters& p);
 
+/// The parameters of a damped pair (y'' + 2αy' + w²y = 0, α ≥ 0, w² ≥ 0) that do not depend on
+/// time, formed once per parameter set: D = α² − w², ω = √(−D) (read when D < 0), δ = √D (read
+/// when D > 0), the fast rate α + δ and the slow rate w²/(α + δ) of the over-damped tail (1/s).
+struct DampedRates {
+  double alpha = 0, w2 = 0, D = 0, omega = 0, delta = 0, fast = 0, slow = 0;
+};
+
 /// Stable parametric evaluators (accurate on and near every branch).
 FreeState free_state(const Parameters& p, double t, double dtheta_m0);
 ContactState contact_state(const Parameters& p, double t, double theta_o0, double dtheta_o0);
@@ -91,8 +98,8 @@ class StableSegments {
   Parameters p_;
   bool at_load_;
   double cot_, a_, b_, k_, a_minus_b_, gap_factor_;  // output at load
-  double alpha_m_, w2_m_;                           // output at motor
-  double alpha_c_, w2_c_;                           // contact
+  DampedRates motor_;                               // output at motor: α = Fm/2Jm, w² = K/Jm
+  DampedRates contact_;                             // contact: α = F/2J, w² = K/J
 };
 
 /// A parameter set lying exactly on a branch (used by validation and tests).
