@@ -102,9 +102,9 @@ struct Start {
 // The start's rate ż(0) = A z0 + c, the same for every witness of a segment, and the size of the
 // terms that form it, |A|(|z0| + z0's rounding) + c's terms (its rounding scale): formed once per
 // segment, the latter only when a witness starts on its boundary (classify_start).
-class StartRates {
+class SegmentStartRate {
  public:
-  explicit StartRates(const ModeFlow& flow)
+  explicit SegmentStartRate(const ModeFlow& flow)
       : flow_(flow), zdot_(flow.segment().A * flow.local_start() + flow.segment().c) {}
   const SmallVector& zdot() const { return zdot_; }
   const SmallVector& scale() const {
@@ -134,7 +134,7 @@ class StartRates {
 // formed again; the higher derivatives and their rounding scales only on the boundary.
 // `rates`: the start's rate and its rounding scale, the same for every witness of the segment.
 // w^{(K)} and its scale are formed for K up to the first that decides (the same bits as all of them).
-Start classify_start(const ModeFlow& flow, const WitnessMode& mode, double level, const StartRates& rates,
+Start classify_start(const ModeFlow& flow, const WitnessMode& mode, double level, const SegmentStartRate& rates,
                      double magnitude, double horizon, double t_global) {
   const SmallVector& zdot = rates.zdot();
   const SmallVector& z0 = flow.local_start();
@@ -309,7 +309,7 @@ class SampleMemo {
 // The certified search for one witness's first exit, advanced window by window.
 class ExitSearch {
  public:
-  ExitSearch(const Parameters& p, const ModeFlow& flow, const SampleMemo& memo, const StartRates& rates,
+  ExitSearch(const Parameters& p, const ModeFlow& flow, const SampleMemo& memo, const SegmentStartRate& rates,
              std::uint64_t group, const Witness& witness, double horizon, double t_global)
       : p_(p), flow_(flow), memo_(memo), witness_(witness) {
     level_ = -witness.f.constant;
@@ -448,7 +448,7 @@ class ClosedFormSegment final : public detail::Segment {
     detail::mode_witnesses(p, e, m, functionals_of(p, e, flow_, left_zone), true, witnesses);
     witnesses.insert(witnesses.end(), extra.begin(), extra.end());
     const SampleMemo memo(flow_);
-    const StartRates rates(flow_);  // ż(0), and its rounding scale when a witness starts on its boundary
+    const SegmentStartRate rates(flow_);  // ż(0), and its rounding scale when a witness starts on its boundary
     searches.reserve(witnesses.size());
     const std::uint64_t group = detail::kept_mode_group(flow_.segment().A);  // the witnesses' A, compared once
     for (const Witness& w : witnesses) {

@@ -371,8 +371,6 @@ class ClosedFormRun {
   void record(double upto, const At& at, FunctionRef<int(double, double*, int)> turns);
   template <class At>
   [[gnu::noinline]] void record_in_band(double upto, const At& at, FunctionRef<int(double, double*, int)> turns);
-  // θo perhaps outside the sample band (not inside it by the margin: BandTest).
-  bool keep_sample(double o) const { return band_->may_be_outside(o); }
   void flush_samples() {
     if (band_) recorder_.flush(*band_);
   }
@@ -552,7 +550,7 @@ void ClosedFormRun::record(double upto, const At& at, FunctionRef<int(double, do
 // record() with a sample band: out of line, so that the event loop compiles as without it (issue 19).
 template <class At>
 void ClosedFormRun::record_in_band(double upto, const At& at, FunctionRef<int(double, double*, int)> turns) {
-  const auto keep = [this](double o) { return keep_sample(o); };
+  const auto keep = [this](double o) { return band_->may_be_outside(o); };  // not inside by the margin
   std::array<double, TrajectoryRecorder::kMaxTurns> times;
   const int count = turns(upto - t_, times.data(), static_cast<int>(times.size()));
   bool skip = count >= 0 && !keep(measured(p_, at(0))) && !keep(measured(p_, at(upto - t_)));

@@ -43,19 +43,15 @@ double horizon_from_rates(std::initializer_list<double> rates, double natural_ti
 // repeats.  Both parts are ascending already (horizon·i/points rounds monotonically in i for a
 // horizon > 0), so they are merged instead of sorted: the same grid.
 std::vector<double> time_grid(double horizon, int points) {
-  std::vector<double> early{0.0};
+  std::vector<double> grid;
+  grid.reserve(6 + static_cast<std::size_t>(std::max(0, points)));
+  grid.push_back(0.0);
   for (double t : {1e-8, 1e-6, 1e-4, 1e-3, 1e-2})
-    if (t < horizon) early.push_back(t);
-  std::vector<double> uniform;
-  uniform.reserve(static_cast<std::size_t>(std::max(0, points)));
-  for (int i = 1; i <= points; ++i) uniform.push_back(horizon * i / points);
-  std::vector<double> grid(early.size() + uniform.size());
-  if (horizon > 0) {
-    std::merge(early.begin(), early.end(), uniform.begin(), uniform.end(), grid.begin());
-  } else {  // not ascending (or NaN): sorted as given
-    std::copy(uniform.begin(), uniform.end(), std::copy(early.begin(), early.end(), grid.begin()));
-    std::sort(grid.begin(), grid.end());
-  }
+    if (t < horizon) grid.push_back(t);
+  const auto early_end = static_cast<std::ptrdiff_t>(grid.size());
+  for (int i = 1; i <= points; ++i) grid.push_back(horizon * i / points);
+  if (horizon > 0) std::inplace_merge(grid.begin(), grid.begin() + early_end, grid.end());
+  else std::sort(grid.begin(), grid.end());  // not ascending (or NaN): sorted as given
   grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
   return grid;
 }
