@@ -9,8 +9,9 @@
 //   time_ClosedFormPerEvent/<case>/<T>   the same step response to T = 60 s and 60,000 s with
 //                                        the events sunk (event_sink, nothing kept): the cost
 //                                        per event and whether it grows with the horizon.
-// Every closed-form benchmark counts the heap allocations of its timed loop (the global
-// operator new below): counters allocs_per_run and, per event, allocs_per_event.
+// Every closed-form benchmark counts the heap allocations of its timed loop (the replaced global
+// allocation functions of tests/support/counting_operator_new.hpp): counters allocs_per_run and,
+// per event, allocs_per_event.
 // Each case's step is its [experiment] step (the thesis's first worked step input).
 // Validation (the gate) happens once, outside the timed loops.
 //
@@ -23,6 +24,7 @@
 #include "backlash/numeric/hybrid_simulation.hpp"
 #include "backlash/numeric/odeint_simulation.hpp"
 #include "backlash/numeric/validation.hpp"
+#include "counting_operator_new.hpp"  // counts every heap allocation (one TU only)
 
 #include <benchmark/benchmark.h>
 
@@ -36,23 +38,6 @@
 #include <string>
 #include <vector>
 
-namespace {
-std::atomic<long> allocations{0};  // every operator new of this binary (the library's too)
-}  // namespace
-
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"  // the counting operator new is malloc, its delete free
-void* operator new(std::size_t size) {
-  allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return operator new(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-#pragma GCC diagnostic pop
 
 namespace {
 
@@ -107,13 +92,13 @@ void time_ClosedFormStepResponse(benchmark::State& state, std::size_t index) {
   const Case& c = cases()[index];
   const auto options = simulation_options();
   std::size_t events = 0;
-  const long allocations0 = allocations.load();
+  const long allocations0 = backlash::testing::heap_allocations.load();
   for (auto _ : state) {
     const numeric::SimulationResult r = numeric::simulate_step(*c.evaluator, c.step, options);
     events = r.events.size();
     benchmark::DoNotOptimize(r.theta_o_final);
   }
-  const double per_run = static_cast<double>(allocations.load() - allocations0) / static_cast<double>(state.iterations());
+  const double per_run = static_cast<double>(backlash::testing::heap_allocations.load() - allocations0) / static_cast<double>(state.iterations());
   state.counters["events"] = static_cast<double>(events);
   state.counters["allocs_per_run"] = per_run;  // the kept event list's growth included
 }
@@ -125,14 +110,14 @@ void time_ClosedFormPerEvent(benchmark::State& state, std::size_t index, double 
   long events = 0;
   options.event_sink = [&events](const numeric::SimulationEvent&) { ++events; };
   long run_events = 0;
-  const long allocations0 = allocations.load();
+  const long allocations0 = backlash::testing::heap_allocations.load();
   for (auto _ : state) {
     events = 0;
     const numeric::SimulationResult r = numeric::simulate_step(*c.evaluator, c.step, options);
     run_events = events;
     benchmark::DoNotOptimize(r.theta_o_final);
   }
-  const double per_run = static_cast<double>(allocations.load() - allocations0) / static_cast<double>(state.iterations());
+  const double per_run = static_cast<double>(backlash::testing::heap_allocations.load() - allocations0) / static_cast<double>(state.iterations());
   state.counters["events"] = static_cast<double>(run_events);
   state.counters["allocs_per_run"] = per_run;
   state.counters["allocs_per_event"] = per_run / static_cast<double>(std::max(1L, run_events));

@@ -8,12 +8,13 @@
 //                                         events are the same for t_end = 60 s and 60,000 s (the first
 //                                         search interval comes from the mode's own time scale, not
 //                                         from t_end).
-// The global operator new below counts every heap allocation of this binary (the library's too).
+// tests/support/counting_operator_new.hpp counts every heap allocation of this binary (the library's too).
 #include "backlash/model/case_spec.hpp"
 #include "backlash/numeric/evaluator.hpp"
 #include "backlash/numeric/hybrid_simulation.hpp"
 #include "backlash/numeric/validation.hpp"
 #include "counting_evaluator.hpp"
+#include "counting_operator_new.hpp"  // counts every heap allocation (one TU only)
 
 #include <gtest/gtest.h>
 
@@ -26,23 +27,6 @@
 #include <new>
 #include <string>
 
-namespace {
-std::atomic<long> allocations{0};
-}  // namespace
-
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"  // the counting operator new is malloc, its delete free
-void* operator new(std::size_t size) {
-  allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](std::size_t size) { return operator new(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
-#pragma GCC diagnostic pop
 
 namespace {
 
@@ -82,9 +66,9 @@ Cost run(const std::string& id, double t_end, long max_events) {
   o.event_sink = [&cost](const numeric::SimulationEvent&) { ++cost.events; };
   const numeric::ValidatedEvaluator& evaluator = c.validated.evaluator();
   const long evaluations0 = c.counter->evaluations;
-  const long allocations0 = allocations.load();
+  const long allocations0 = backlash::testing::heap_allocations.load();
   const numeric::SimulationResult r = numeric::simulate_step(evaluator, c.step, o);
-  cost.allocations = allocations.load() - allocations0;
+  cost.allocations = backlash::testing::heap_allocations.load() - allocations0;
   cost.evaluations = c.counter->evaluations - evaluations0;
   EXPECT_FALSE(numeric::stopped_early(r.status) && r.status != numeric::SimulationStatus::EventLimit) << r.stop_reason;
   return cost;
