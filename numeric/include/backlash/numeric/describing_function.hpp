@@ -57,8 +57,10 @@ DescribingFunctionPrediction describing_function_prediction(const Parameters& p)
 /// The first guess of a cold limit-cycle search (limit_cycle.hpp) [rad/s]: the predicted cycle of
 /// largest amplitude read as a sinusoid θo − θR = (A − b/2) sin ωt of the load that leaves contact
 /// on the separation line θo − θR = cot φ·θ̇o, so  v = ω(A − b/2)/√(1 + ω² cot² φ).  Its root is
-/// bracketed on 64 values of β and bisected (about a microsecond; describing_function_prediction
-/// scans 20,000 for the report's table).  0 when the prediction does not apply or finds no cycle.
+/// the first sign change on 64 values of β down from 1, bisected to 1e-15; the signs that the
+/// computation can prove without evaluating are not evaluated (docs/design.md, "The limit-cycle
+/// contract"; the same bits; describing_function_prediction scans 20,000 for the report's table).
+/// 0 when the prediction does not apply or finds no cycle.
 double describing_function_separation_velocity(const Parameters& p);
 
 }  // namespace backlash::numeric
