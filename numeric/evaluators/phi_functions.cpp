@@ -154,6 +154,9 @@ ExpPhi1 exp_phi1(double x) {
 }
 
 LoadKernels load_kernels(double x, double y) {
+  // Both nodes ±0 (a segment's start, t = 0): the values the series below give there, exactly
+  // (each of its terms past the first is ±0 added to a nonzero constant).
+  if (x == 0 && y == 0) return {1, 1, inverse_factorial[2], 1, 1, inverse_factorial[2], inverse_factorial[3]};
   const PhiPair px = phi_pair_of(x), py = phi_pair_of(y);
   LoadKernels k{px.e, px.phi1, px.phi2, py.e, py.phi1, 0, 0};
   const double ax = std::fabs(x), ay = std::fabs(y);
@@ -259,6 +262,9 @@ DampedRates damped_rates(double alpha, double w2) {
 
 DampedPair damped_pair(const DampedRates& r, double t) {
   const double alpha = r.alpha;
+  // t = ±0 (a segment's start): the series below gives C = 1, S = 1 and e^{−α·0} = 1 exactly,
+  // so {1, 1·1·t} = {1, t}, its sign of zero too — for finite α and D (else NaN, as below).
+  if (t == 0 && std::isfinite(alpha) && std::isfinite(r.D)) return {1, t};
   const double z = r.D * t * t;
   if (std::fabs(z) <= 0.25) {
     // C = Σ z^k/(2k)!, S/t = Σ z^k/(2k+1)!
