@@ -1,6 +1,7 @@
 #include "backlash/numeric/parametric.hpp"
 
 #include "evaluators/phi_functions.hpp"
+#include "evaluators/phi_kernels.hpp"
 
 #include <cmath>
 #include <limits>
@@ -118,7 +119,7 @@ FreeState StableSegments::free_state(double t, double v0) const {
   const double y = -b_ * t;
   const double theta0 = p_.theta_R + cot_ * v0;
   if (at_load_) {
-    const LoadKernels q = load_kernels(-a_ * t, y);
+    const LoadKernels q = detail::load_kernels_of(-a_ * t, y);
     const double t2 = t * t, t3 = t2 * t;
     s.theta_L = theta0 + v0 * t * q.phi1_y;
     s.dtheta_L = v0 * q.exp_y;
@@ -143,7 +144,7 @@ FreeState StableSegments::free_state(double t, double v0) const {
 
 ContactState StableSegments::contact_state(double t, double theta_o0, double dtheta_o0) const {
   const double e0 = theta_o0 - p_.theta_R;
-  const DampedPair q = damped_pair(contact_, t);
+  const DampedPair q = detail::damped_pair_of(contact_, t);
   return {p_.theta_R + e0 * q.c + (dtheta_o0 + contact_.alpha * e0) * q.s,
           dtheta_o0 * q.c - (contact_.alpha * dtheta_o0 + contact_.w2 * e0) * q.s};
 }
