@@ -160,11 +160,6 @@ class CycleCertificate {
   double next_try_ = 0;  // |u − v*| at which the next try is made
 };
 
-// Thrown from the run's event sink once every later θo is certified inside the moving band at a
-// separation other than the expected one: the run ends there (its samples so far are those of the
-// whole run up to that time).
-struct InsideFromHere {};
-
 using Certificate = std::function<bool(const SimulationEvent&)>;
 
 // The settle time from `simulate(options)`: with samples left out by the moving band, again with
@@ -172,7 +167,8 @@ using Certificate = std::function<bool(const SimulationEvent&)>;
 // `certificate` (nominal runs toward a stable cycle), the first run stops at the separation from
 // which the rest of the motion is certified inside the band (CycleCertificate): at the
 // `expected` one (SettleOptions::expected_separation) the simulator ends it there
-// (stop_after_separations), at any other the event sink unwinds it.  A run that reached the
+// (stop_after_separations), at any other the event sink asks it to (stop_requested: its samples
+// so far are those of the whole run up to that time).  A run that reached the
 // expected separation uncertified is run again from the start, its certificate skipping the
 // separations it has already judged: the same tries, the same answer.
 template <class Simulate>
@@ -182,20 +178,18 @@ Settle settled(const Simulate& simulate, const Parameters& p, const LimitCycle& 
   SimulationOptions first = sampled(o, theta_o, moving_band(p, cycle, o.fraction * std::fabs(o.step)));
   double stopped = NAN;
   long separations = 0;
+  bool inside_from_here = false;
   if (certificate) {
     first.stop_after_separations = expected;
-    first.event_sink = [&certificate, &stopped, &separations, expected](const SimulationEvent& e) {
+    first.stop_requested = &inside_from_here;
+    first.event_sink = [&certificate, &stopped, &separations, &inside_from_here](const SimulationEvent& e) {
       separations += e.kind == EventKind::Separation;
       if (!certificate(e)) return;
       stopped = e.t;
-      if (separations != expected) throw InsideFromHere{};
+      inside_from_here = true;
     };
   }
-  SimulationResult run;
-  try {
-    run = simulate(first);
-  } catch (const InsideFromHere&) {
-  }
+  SimulationResult run = simulate(first);
   if (!std::isnan(stopped)) {
     Settle s = judge(run, theta_o, p, cycle, o, true);
     s.stopped_at = stopped;

@@ -97,24 +97,6 @@ const GeneratedCase* find_case(const std::string& id) {
   return nullptr;
 }
 
-class ParametricEvaluator final : public SegmentEvaluator {
- public:
-  explicit ParametricEvaluator(const Parameters& p) : segments_(p), branches_(select_branches(p)) {}
-  std::string name() const override { return "parametric (stable)"; }
-  std::string kind() const override { return "parametric"; }
-  const Parameters& parameters() const override { return segments_.parameters(); }
-  BranchSelection branches() const override { return branches_; }
-  double cot_phi() const override { return segments_.cot_phi(); }
-  FreeState free_state(double t, double v0) const override { return segments_.free_state(t, v0); }
-  ContactState contact_state(double t, double x0, double v0) const override {
-    return segments_.contact_state(t, x0, v0);
-  }
-
- private:
-  StableSegments segments_;
-  BranchSelection branches_;
-};
-
 class DirectEvaluator final : public SegmentEvaluator {
  public:
   explicit DirectEvaluator(const Parameters& p)
@@ -159,7 +141,6 @@ std::vector<std::string> generated_case_exact_parameters(const std::string& case
   return c ? c->exact : std::vector<std::string>{};
 }
 
-EvaluatorPtr parametric_evaluator(const Parameters& p) { return std::make_shared<ParametricEvaluator>(p); }
 EvaluatorPtr direct_branch_evaluator(const Parameters& p) { return std::make_shared<DirectEvaluator>(p); }
 
 EvaluatorPtr case_evaluator(const model::CaseSpec& spec) {

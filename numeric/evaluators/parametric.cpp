@@ -1,9 +1,14 @@
 #include "backlash/numeric/parametric.hpp"
 
+#include "backlash/numeric/evaluator.hpp"
+
 #include "evaluators/phi_functions.hpp"
+#include "evaluators/phi_kernels.hpp"
 
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <string>
 
 namespace backlash::numeric {
 
@@ -118,7 +123,7 @@ FreeState StableSegments::free_state(double t, double v0) const {
   const double y = -b_ * t;
   const double theta0 = p_.theta_R + cot_ * v0;
   if (at_load_) {
-    const LoadKernels q = load_kernels(-a_ * t, y);
+    const LoadKernels q = detail::load_kernels_of(-a_ * t, y);
     const double t2 = t * t, t3 = t2 * t;
     s.theta_L = theta0 + v0 * t * q.phi1_y;
     s.dtheta_L = v0 * q.exp_y;
@@ -143,10 +148,36 @@ FreeState StableSegments::free_state(double t, double v0) const {
 
 ContactState StableSegments::contact_state(double t, double theta_o0, double dtheta_o0) const {
   const double e0 = theta_o0 - p_.theta_R;
-  const DampedPair q = damped_pair(contact_, t);
+  const DampedPair q = detail::damped_pair_of(contact_, t);
   return {p_.theta_R + e0 * q.c + (dtheta_o0 + contact_.alpha * e0) * q.s,
           dtheta_o0 * q.c - (contact_.alpha * dtheta_o0 + contact_.w2 * e0) * q.s};
 }
+
+namespace {
+
+// The parametric evaluator (evaluator.hpp), beside its closed forms: its evaluations inline
+// StableSegments' (one call per evaluation, the same bits).
+class ParametricEvaluator final : public SegmentEvaluator {
+ public:
+  explicit ParametricEvaluator(const Parameters& p) : segments_(p), branches_(select_branches(p)) {}
+  std::string name() const override { return "parametric (stable)"; }
+  std::string kind() const override { return "parametric"; }
+  const Parameters& parameters() const override { return segments_.parameters(); }
+  BranchSelection branches() const override { return branches_; }
+  double cot_phi() const override { return segments_.cot_phi(); }
+  FreeState free_state(double t, double v0) const override { return segments_.free_state(t, v0); }
+  ContactState contact_state(double t, double x0, double v0) const override {
+    return segments_.contact_state(t, x0, v0);
+  }
+
+ private:
+  StableSegments segments_;
+  BranchSelection branches_;
+};
+
+}  // namespace
+
+EvaluatorPtr parametric_evaluator(const Parameters& p) { return std::make_shared<ParametricEvaluator>(p); }
 
 FreeState free_state(const Parameters& p, double t, double v0) { return StableSegments(p).free_state(t, v0); }
 

@@ -86,32 +86,81 @@ WitnessSample sample_of(const LinearWitness& witness, double t) {
 
 }  // namespace
 
+namespace {
+
+// What a witness's constants take from its matrix A alone (μ∞ and the balancing D, the first
+// window, ‖D A‖∞, ‖A‖∞, max 1/D_i): the same for every witness on one mode matrix.
+struct MatrixScales {
+  double mu_A, first_window, norm_A, norm_A_plain, inverse_scale;
+  SmallVector scale;
+};
+
+MatrixScales matrix_scales(const SmallMatrix& A) {
+  MatrixScales m;
+  m.mu_A = log_norm(A);
+  m.first_window = window_of(A);
+  m.scale = SmallVector::Ones(A.rows());
+  if (m.mu_A > 0) {
+    const SmallVector d = detail::balancing(A);
+    const SmallMatrix balanced = d.asDiagonal() * A * d.cwiseInverse().asDiagonal();
+    const double mu_balanced = log_norm(balanced);
+    if (mu_balanced * kBalanceGain < m.mu_A) {
+      m.scale = d;
+      m.mu_A = mu_balanced;
+    }
+  }
+  m.norm_A = (m.scale.asDiagonal() * A).cwiseAbs().rowwise().sum().maxCoeff();
+  m.norm_A_plain = A.cwiseAbs().rowwise().sum().maxCoeff();
+  m.inverse_scale = m.scale.cwiseInverse().maxCoeff();
+  return m;
+}
+
+// matrix_scales(A), kept by A's bits (this thread's last four matrices): a parameter set's gap
+// and velocity witnesses share the free mode's A, a map's points the contact mode's (docs/design.md,
+// "Design-space maps") — the same function of the same bits, computed once.
+const MatrixScales& kept_matrix_scales(const SmallMatrix& A) {
+  struct Kept {
+    std::array<double, 16> bits{};
+    Eigen::Index rows = -1, cols = -1;
+    MatrixScales scales;
+  };
+  thread_local std::array<Kept, 4> kept;
+  thread_local std::size_t next = 0;
+  const auto same = [&A](const Kept& k) {
+    return k.rows == A.rows() && k.cols == A.cols() &&
+           std::memcmp(k.bits.data(), A.data(), sizeof(double) * static_cast<std::size_t>(A.size())) == 0;
+  };
+  for (const Kept& k : kept)
+    if (same(k)) return k.scales;
+  Kept& k = kept[next];
+  next = (next + 1) % kept.size();
+  k.rows = A.rows();
+  k.cols = A.cols();
+  std::copy(A.data(), A.data() + A.size(), k.bits.data());
+  k.scales = matrix_scales(A);
+  return k.scales;
+}
+
+}  // namespace
+
 WitnessMode::WitnessMode(const SmallMatrix& A_, const SmallVector& c_, const SmallRow& e_, double time_unit_)
     : A(A_), e(e_), time_unit(time_unit_) {
   eA = e * A;
   eA2 = eA * A;
   eA3 = eA2 * A;
   set_forcing(c_);
-  mu_A = log_norm(A);
-  first_window = window_of(A);
-  scale = SmallVector::Ones(A.rows());
-  if (mu_A > 0) {
-    const SmallVector d = detail::balancing(A);
-    const SmallMatrix balanced = d.asDiagonal() * A * d.cwiseInverse().asDiagonal();
-    const double mu_balanced = log_norm(balanced);
-    if (mu_balanced * kBalanceGain < mu_A) {
-      scale = d;
-      mu_A = mu_balanced;
-    }
-  }
+  const MatrixScales& m = A.size() <= 16 ? kept_matrix_scales(A) : matrix_scales(A);
+  mu_A = m.mu_A;
+  first_window = m.first_window;
+  scale = m.scale;
   norm_e = e.cwiseQuotient(scale.transpose()).cwiseAbs().sum();
   norm_eA2 = eA2.cwiseQuotient(scale.transpose()).cwiseAbs().sum();
   norm_eA3 = eA3.cwiseQuotient(scale.transpose()).cwiseAbs().sum();
   norm_e_plain = e.cwiseAbs().sum();
   norm_eA = eA.cwiseAbs().sum();
-  norm_A = (scale.asDiagonal() * A).cwiseAbs().rowwise().sum().maxCoeff();
-  norm_A_plain = A.cwiseAbs().rowwise().sum().maxCoeff();
-  inverse_scale = scale.cwiseInverse().maxCoeff();
+  norm_A = m.norm_A;
+  norm_A_plain = m.norm_A_plain;
+  inverse_scale = m.inverse_scale;
 }
 
 void WitnessMode::set_forcing(const SmallVector& forcing) {

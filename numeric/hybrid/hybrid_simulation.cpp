@@ -129,6 +129,7 @@ class Flight {
     f.offset_m_ = start.theta_m - theta0;
     f.offset_L_ = start.theta_L - theta0;
     f.face_ = start.face;
+    f.start_ = f.evaluated(0.0);  // the searches' first point, the recorder's and the extremes' start
     return f;
   }
   static Flight from_state(const Parameters& p, const HybridState& start) {
@@ -161,6 +162,13 @@ class Flight {
       }
       return s;
     }
+    if (tau == 0 && !std::signbit(tau)) return start_;  // τ = +0: evaluated once, at the flight's start
+    return evaluated(tau);
+  }
+
+ private:
+  // One closed-form evaluation: x(τ) in the run's frame and the gap change.
+  WitnessSample evaluated(double tau) const {
     const FreeState f = evaluator_->free_state(tau, v_);
     WitnessSample s{SmallVector(4), f.gap};
     s.x(0) = f.theta_m + offset_m_;
@@ -170,10 +178,10 @@ class Flight {
     return s;
   }
 
- private:
   const ValidatedEvaluator* evaluator_ = nullptr;
   double v_ = 0, offset_m_ = 0, offset_L_ = 0;
   int face_ = 0;
+  WitnessSample start_;  // evaluated(+0) of a flight from the separation line
   std::optional<LinearFlight> linear_;
 };
 
@@ -490,6 +498,7 @@ std::optional<SimulationStatus> ClosedFormRun::contact() {
   state_.in_contact = false;  // face σ is the face just left
   push_event(EventKind::Separation, false, false);
   if (o_.stop_after_separations > 0 && ++separations_ >= o_.stop_after_separations) return SimulationStatus::Completed;
+  if (o_.stop_requested && *o_.stop_requested) return SimulationStatus::Completed;
   return std::nullopt;
 }
 

@@ -6,7 +6,8 @@
 //                                                 of 1 … 12, one far past the stop) is the one
 //                                                 without, field for field: the simulator ends the
 //                                                 run at the expected separation when the check
-//                                                 holds there, the sink unwinds it at another, and
+//                                                 holds there, the sink stops it at another
+//                                                 (stop_requested), and
 //                                                 a run that reached it unchecked runs again;
 //   item_map_settle_one_sided_check_equals_the_run_to_t_end   on those points with g'(v*) > 0
 //                                                 (Newton's cycle: the one-sided interval between

@@ -2,10 +2,12 @@
 // (the kernels' phi_pair inlined, the damped pair's D, √(−D), √D and rates formed once per
 // parameter set) give the bits of the formulas they replace, kept here verbatim as the reference:
 //   check_kernels_as_before   phi_pair, exp_phi1, load_kernels, coupled_kernels on random nodes
-//                             across every branch (series, expm1/exp, separated, close, equal, 0);
+//                             across every branch (series, expm1/exp, separated, close, equal, 0;
+//                             load_kernels' shortcut at x = y = ±0);
 //   check_damped_pair_as_before
 //                             damped_pair(α, w², t) and damped_pair(damped_rates(α, w²), t) on
-//                             every branch (series, under-damped, cosh/sinh, two exponentials);
+//                             every branch (series, under-damped, cosh/sinh, two exponentials;
+//                             the shortcut at t = ±0, with α or D not finite there too);
 //   check_segments_as_before  StableSegments::free_state / contact_state, every component, on
 //                             random parameter sets of both outputs (FL = 0, Fm = 0, equal rates,
 //                             critical damping included).
@@ -272,7 +274,9 @@ TEST(ParametricAsBefore, check_damped_pair_as_before) {
       case 3: w2 = alpha * alpha * u(rng); break;                      // over-damped
       default: w2 = std::pow(10.0, 6 * u(rng) - 3); break;
     }
-    const double t = i % 101 == 0 ? 0.0 : std::pow(10.0, 6 * u(rng) - 3);
+    // t = ±0 (damped_pair's shortcut at a segment's start), α and D not finite there too
+    const double t = i % 101 == 0 ? (i % 202 == 0 ? 0.0 : -0.0) : std::pow(10.0, 6 * u(rng) - 3);
+    if (t == 0 && i % 5 == 0) w2 = i % 10 == 0 ? INFINITY : NAN;
     const n::DampedPair a = n::damped_pair(alpha, w2, t), b = n::damped_pair(n::damped_rates(alpha, w2), t);
     const n::DampedPair o = old_damped_pair(alpha, w2, t);
     EXPECT_BITS(a.c, o.c);
@@ -302,12 +306,12 @@ TEST(ParametricAsBefore, check_segments_as_before) {
       case 4: p.FL = 2 * std::sqrt((p.Jm + p.JL) * p.K) - p.Fm; break;  // contact critical
       default: break;
     }
-    p.theta_R = 4 * u(rng) - 2;
+    p.theta_R = set % 7 == 0 ? 0.0 : 4 * u(rng) - 2;  // θR = 0: the signs of zeros at t = ±0
     p.measured_at = set % 2 ? backlash::model::MeasuredAt::Motor : backlash::model::MeasuredAt::Load;
     const n::StableSegments segments(p);
     for (int i = 0; i < 100; ++i) {
-      const double t = i == 0 ? 0.0 : std::pow(10.0, 5 * u(rng) - 3);
-      const double v0 = 4 * u(rng) - 2, x0 = p.theta_R + 4 * u(rng) - 2;
+      const double t = i == 0 ? 0.0 : i == 1 ? -0.0 : std::pow(10.0, 5 * u(rng) - 3);
+      const double v0 = i == 2 ? 0.0 : 4 * u(rng) - 2, x0 = i == 3 ? p.theta_R : p.theta_R + 4 * u(rng) - 2;
       const n::FreeState f = segments.free_state(t, v0), of = old_free_state(p, t, v0);
       EXPECT_BITS(f.theta_m, of.theta_m);
       EXPECT_BITS(f.dtheta_m, of.dtheta_m);

@@ -103,6 +103,10 @@ struct SimulationOptions {
   /// (zeno_window(p, options)), so that the rule means the same for K = 1 and K = 1e12.
   double zeno_window = 0;
   long stop_after_separations = 0;  ///< > 0: stop (status completed) right after this many separations
+  /// Set: read right after each separation's event has reached event_sink; true stops the run
+  /// there (status completed), as stop_after_separations does — for a sink that decides at an
+  /// event whether the run goes on (settle.cpp).  Honoured by simulate().
+  const bool* stop_requested = nullptr;
   bool track_extremes = false;      ///< record the exact extremes of θo, θm, θL (zeros of the velocities)
   /// Set (θo in the caller's frame): for a caller that needs only the last sample outside
   /// [low, high] (settle.hpp), the closed-form simulator leaves out samples (counted in

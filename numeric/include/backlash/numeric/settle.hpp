@@ -54,7 +54,7 @@ struct SettleOptions {
   bool stop_on_cycle = true;
   /// > 0: the separation (1, 2, …) at which the stop on the cycle is expected — a map's neighbour's
   /// Settle::stopped_separation (continuation): the simulator ends the run there instead of the
-  /// event sink unwinding it.  A hint only: the answer is the same for any value.
+  /// event sink asking it to stop there.  A hint only: the answer is the same for any value.
   long expected_separation = 0;
 };
 
