@@ -8,6 +8,7 @@
 
 namespace backlash::numeric {
 
+using detail::exp_divided_difference;
 using detail::inverse_factorial;
 using detail::phi_pair_of;
 using detail::phi_series;
@@ -120,16 +121,7 @@ CoupledKernels coupled_kernels(double x, double y) {
     k.a2 = (px.phi2 - py.phi2) / d;
     k.a3 = (phi3_from(x, px.phi2) - phi3_from(y, py.phi2)) / d;
   } else {
-    const double half = 0.5 * d;
-    double a0;
-    if (std::fabs(half) < 0.5) {
-      const double h2 = half * half;
-      double shc = inverse_factorial[19];
-      for (int j = 8; j >= 0; --j) shc = shc * h2 + inverse_factorial[2 * j + 1];
-      a0 = std::exp(0.5 * (x + y)) * shc;
-    } else {
-      a0 = (px.e - py.e) / d;
-    }
+    const double a0 = exp_divided_difference(x, y, d, px, py);
     const bool x_larger = ax >= ay;
     const double node = x_larger ? x : y, other = x_larger ? y : x;
     const PhiPair& o = x_larger ? py : px;

@@ -81,6 +81,20 @@ inline void pair_series(double x, double y, double m, double& a1, double& a2) {
   return {e, phi1, (phi1 - 1.0) / x};
 }
 
+// A0 = exp[x, y] = (e^x − e^y)/(x − y) of two close nodes (d = x − y ≠ 0): e^{(x+y)/2}·shc(d/2),
+// shc(h) = sinh(h)/h by its series, for |d| < 1; else the difference quotient of px.e and py.e.
+[[gnu::always_inline]] inline double exp_divided_difference(double x, double y, double d, const PhiPair& px,
+                                                            const PhiPair& py) {
+  const double half = 0.5 * d;
+  if (std::fabs(half) < 0.5) {
+    const double h2 = half * half;
+    double shc = inverse_factorial[19];
+    for (int j = 8; j >= 0; --j) shc = shc * h2 + inverse_factorial[2 * j + 1];
+    return std::exp(0.5 * (x + y)) * shc;
+  }
+  return (px.e - py.e) / d;
+}
+
 // load_kernels (phi_functions.hpp).
 [[gnu::always_inline]] inline LoadKernels load_kernels_of(double x, double y) {
   // Both nodes ±0 (a segment's start, t = 0): the values the series below give there, exactly
@@ -99,16 +113,7 @@ inline void pair_series(double x, double y, double m, double& a1, double& a2) {
     k.a2 = (px.phi2 - py.phi2) / d;
   } else {
     // close nodes away from 0: A0 = exp[x, y], then peel the zeros off the larger node
-    const double half = 0.5 * d;
-    double a0;
-    if (std::fabs(half) < 0.5) {
-      const double h2 = half * half;
-      double shc = inverse_factorial[19];
-      for (int j = 8; j >= 0; --j) shc = shc * h2 + inverse_factorial[2 * j + 1];
-      a0 = std::exp(0.5 * (x + y)) * shc;
-    } else {
-      a0 = (px.e - py.e) / d;
-    }
+    const double a0 = exp_divided_difference(x, y, d, px, py);
     const bool x_larger = ax >= ay;
     const double node = x_larger ? x : y;
     const PhiPair& other = x_larger ? py : px;
