@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <optional>
 
 namespace backlash::numeric {
 
@@ -88,6 +89,48 @@ WitnessSample sample_of(const LinearWitness& witness, double t) {
 
 namespace {
 
+// A per-thread memo of the last N values of a pure function, kept by the bits of its inputs (Key,
+// compared with ==): a kept value is what computing again would give.  The least recently used
+// goes.  kept_matrix_scales and kept_witness_mode use it.
+template <class Key, class Value, std::size_t N>
+class RecentlyKept {
+ public:
+  template <class Compute>
+  const Value& get(const Key& key, const Compute& compute) {
+    std::optional<Slot>* oldest = &slots_[0];
+    for (std::optional<Slot>& s : slots_) {
+      if (s && s->key == key) {
+        s->used = ++clock_;
+        return s->value;
+      }
+      if (!s || (*oldest && s->used < (*oldest)->used)) oldest = &s;  // an empty slot, else the least recently used
+    }
+    oldest->emplace(Slot{key, compute(), ++clock_});
+    return (*oldest)->value;
+  }
+
+ private:
+  struct Slot {
+    Key key;
+    Value value;
+    long used = 0;
+  };
+  std::array<std::optional<Slot>, N> slots_;
+  long clock_ = 0;
+};
+
+// The bits of a matrix of at most 16 entries, with its shape.
+struct MatrixKey {
+  std::array<double, 16> bits{};
+  Eigen::Index rows = -1, cols = -1;
+  explicit MatrixKey(const SmallMatrix& A) : rows(A.rows()), cols(A.cols()) {
+    std::copy(A.data(), A.data() + A.size(), bits.data());
+  }
+  bool operator==(const MatrixKey& o) const {
+    return rows == o.rows && cols == o.cols && std::memcmp(bits.data(), o.bits.data(), sizeof bits) == 0;
+  }
+};
+
 // What a witness's constants take from its matrix A alone (μ∞ and the balancing D, the first
 // window, ‖D A‖∞, ‖A‖∞, max 1/D_i): the same for every witness on one mode matrix.
 struct MatrixScales {
@@ -119,26 +162,8 @@ MatrixScales matrix_scales(const SmallMatrix& A) {
 // and velocity witnesses share the free mode's A, a map's points the contact mode's (docs/design.md,
 // "Design-space maps") — the same function of the same bits, computed once.
 const MatrixScales& kept_matrix_scales(const SmallMatrix& A) {
-  struct Kept {
-    std::array<double, 16> bits{};
-    Eigen::Index rows = -1, cols = -1;
-    MatrixScales scales;
-  };
-  thread_local std::array<Kept, 4> kept;
-  thread_local std::size_t next = 0;
-  const auto same = [&A](const Kept& k) {
-    return k.rows == A.rows() && k.cols == A.cols() &&
-           std::memcmp(k.bits.data(), A.data(), sizeof(double) * static_cast<std::size_t>(A.size())) == 0;
-  };
-  for (const Kept& k : kept)
-    if (same(k)) return k.scales;
-  Kept& k = kept[next];
-  next = (next + 1) % kept.size();
-  k.rows = A.rows();
-  k.cols = A.cols();
-  std::copy(A.data(), A.data() + A.size(), k.bits.data());
-  k.scales = matrix_scales(A);
-  return k.scales;
+  thread_local RecentlyKept<MatrixKey, MatrixScales, 4> kept;
+  return kept.get(MatrixKey(A), [&A] { return matrix_scales(A); });
 }
 
 }  // namespace
@@ -302,24 +327,8 @@ struct ModeKey {
 
 WitnessMode detail::kept_witness_mode(const SmallMatrix& A, const SmallVector& c, const SmallRow& e, double time_unit) {
   if (A.size() > 16 || c.size() > 4 || e.size() > 4) return WitnessMode(A, c, e, time_unit);
-  struct Kept {
-    ModeKey key;
-    WitnessMode mode;
-    long used = 0;
-  };
-  thread_local std::array<std::optional<Kept>, 4> kept;
-  thread_local long clock = 0;
-  const ModeKey key(A, c, e, time_unit);
-  std::optional<Kept>* oldest = &kept[0];
-  for (std::optional<Kept>& k : kept) {
-    if (k && k->key == key) {
-      k->used = ++clock;
-      return k->mode;
-    }
-    if (!k || (*oldest && k->used < (*oldest)->used)) oldest = &k;  // an empty slot, else the least recently used
-  }
-  oldest->emplace(Kept{key, WitnessMode(A, c, e, time_unit), ++clock});
-  return (*oldest)->mode;
+  thread_local RecentlyKept<ModeKey, WitnessMode, 4> kept;
+  return kept.get(ModeKey(A, c, e, time_unit), [&] { return WitnessMode(A, c, e, time_unit); });
 }
 
 std::optional<double> certified_departure(const LinearWitness& witness, double noise) {
