@@ -98,15 +98,15 @@ class ModeFlow {
   ModeFlow(const Parameters& p, const Effects& e, const Mode& m, const HybridState& start);
   const Mode& mode() const { return mode_; }
   /// z' = A z + c in the local coordinates.
-  const LinearSegment& segment() const { return segment_; }
+  const LinearSegment& segment() const { return system_.segment; }
   /// z(τ) from the closed form.
   SmallVector local(double tau) const;
   /// The local coordinates of the start state, and the rounding error they carry (a
   /// deviation formed from absolute positions keeps their rounding, not its own size).
-  const SmallVector& local_start() const { return z0_; }
-  const SmallVector& local_start_noise() const { return z0_noise_; }
+  const SmallVector& local_start() const { return system_.z0; }
+  const SmallVector& local_start_noise() const { return system_.z0_noise; }
   /// The size of the terms that formed the forcing c (its rounding scale: c may cancel).
-  const SmallVector& forcing_magnitude() const { return c_magnitude_; }
+  const SmallVector& forcing_magnitude() const { return system_.c_magnitude; }
   /// The full state at τ (flags of the mode: in_contact, face, stuck, regime).
   HybridState state(double tau) const;
   /// The measured shaft's angle θo at τ, rad: measured(p, state(τ)) bit for bit, with only the
@@ -150,8 +150,7 @@ class ModeFlow {
   Effects e_;
   Mode mode_;
   HybridState start_;
-  LinearSegment segment_;
-  SmallVector z0_, z0_noise_, c_magnitude_;
+  ModeSystem system_;  // A, c, z0, its rounding, c's terms: mode_system's, kept as formed (not copied)
   // closed-form constants
   DampedRates contact_rates_;                      // contact: α = F/2J, w² = K/J (damped_rates)
   double beta_ = 0, g_ = 0;                        // contact
