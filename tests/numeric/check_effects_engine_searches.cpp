@@ -9,6 +9,10 @@
 //                                 matrix is defective) is e^{Mτ} z̃0 formed on Eigen::MatrixXd bit for
 //                                 bit (the flow holds M in a heap-free matrix of at most 5×5), from
 //                                 random starts and times;
+//   check_eigen_flow_as_dynamic   a mesh flow by its eigen-decomposition (kept per thread, its V⁻¹ by
+//                                 the fixed-size 5 × 5 LU, |λ_j|³ once per conjugate pair) gives the
+//                                 bits of the decomposition formed on Eigen::MatrixXd / MatrixXcd, each
+//                                 |λ_j|³ by pow: its states and its bound on |w'''|, from random starts;
 //   item_effects_kept_constants_stay_put
 //                                 a kept witness's constants stay where they are while they are in use:
 //                                 the cache replaces its least recently used entry, so an entry used
@@ -50,6 +54,7 @@
 #include "backlash/numeric/validation.hpp"
 
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 #include <unsupported/Eigen/MatrixFunctions>
 
 #include <cmath>
@@ -155,6 +160,52 @@ TEST(EffectsEngineSearches, check_matrix_exponential_flow_as_dynamic) {
         }
       }
   EXPECT_EQ(checked, 2 * 4 * 5 * 3);
+}
+
+TEST(EffectsEngineSearches, check_eigen_flow_as_dynamic) {
+  using Complex = std::complex<double>;
+  std::mt19937 random(2019);
+  int checked = 0;
+  for_mesh_flows(random, 30, [&checked](const numeric::Mode& m, const numeric::ModeFlow& flow) {
+    ASSERT_FALSE(flow.uses_matrix_exponential()) << m.describe();
+    const int n = static_cast<int>(flow.segment().A.rows()), size = n + 1;
+    Eigen::MatrixXd M = Eigen::MatrixXd::Zero(size, size);
+    M.topLeftCorner(n, n) = flow.segment().A;
+    M.block(0, n, n, 1) = flow.segment().c;
+    const Eigen::EigenSolver<Eigen::MatrixXd> solver(M, true);
+    ASSERT_EQ(solver.info(), Eigen::Success);
+    const Eigen::MatrixXcd V = solver.eigenvectors();
+    const Eigen::VectorXcd lambda = solver.eigenvalues();
+    Eigen::Matrix<Complex, 5, 5> inverse = Eigen::Matrix<Complex, 5, 5>::Zero();
+    inverse.topLeftCorner(size, size) = Eigen::PartialPivLU<Eigen::MatrixXcd>(V).inverse();
+    Eigen::Matrix<double, 5, 1> z0 = Eigen::Matrix<double, 5, 1>::Zero();
+    z0.head(n) = flow.local_start();
+    z0(n) = 1;
+    Eigen::Matrix<Complex, 5, 1> q = Eigen::Matrix<Complex, 5, 1>::Zero();
+    q.head(size) = inverse.topLeftCorner(size, size) * z0.head(size).cast<Complex>();
+    for (double tau : {1e-3, 0.05, 0.4, 2.0}) {
+      const numeric::SmallVector z = flow.local(tau);
+      for (int i = 0; i < n; ++i) {
+        double sum = 0;
+        for (int j = 0; j < size; ++j) sum += numeric::real_of_product(V(i, j), std::exp(lambda(j) * tau) * q(j));
+        EXPECT_TRUE(same_bits(z(i), sum)) << m.describe() << ", tau " << tau << ", row " << i;
+      }
+    }
+    const numeric::SmallRow row = numeric::SmallRow::Random(n);
+    const auto bound = flow.derivative_bound(row, 3);
+    for (auto [a, b] : {std::pair{0.0, 0.1}, std::pair{0.3, 2.0}}) {
+      double expected = 0;
+      for (int j = 0; j < size; ++j) {
+        Complex c = 0;
+        for (int i = 0; i < n; ++i) c += row(i) * V(i, j);
+        const double rate = lambda(j).real();
+        expected += std::abs(c * q(j)) * std::pow(std::abs(lambda(j)), 3) * std::exp(rate * (rate > 0 ? b : a));
+      }
+      EXPECT_TRUE(same_bits(bound(a, b), expected * (1 + 1e-9) + 1e-300)) << m.describe();
+    }
+    ++checked;
+  });
+  EXPECT_GT(checked, 0);
 }
 
 TEST(EffectsEngineSearches, item_effects_kept_constants_stay_put) {
