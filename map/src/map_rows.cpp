@@ -88,24 +88,27 @@ std::string map_csv_header(const MapPlan& plan) {
 std::string map_csv_row(const MapRow& r) {
   thread_local ColumnTexts texts;
   std::size_t column = 0;
-  std::string out = std::to_string(r.index);
-  out.reserve(400);
+  std::string out;
+  out.reserve(400);  // one allocation a row: the pieces below are appended, never concatenated
+  out += std::to_string(r.index);
   for (const double x : r.x) out += ',', texts.append(out, column++, x);
   const numeric::Parameters& p = r.row.point.parameters;
   const numeric::Effects& e = r.row.point.effects;
   for (const double v : numeric::point_column_values(p, e)) out += ',', texts.append(out, column++, v);
   const std::string status = api::status_of(r.row);
   const bool cycle = status == "limit_cycle";
-  out += "," + status + ",";
+  out += ',', out += status, out += ',';
   append_quoted(out, r.row.reason);
-  out += "," + r.row.branches;
+  out += ',', out += r.row.branches;
   const numeric::LimitCycle& c = r.row.cycle;
   for (const double v : {c.peak_to_peak, c.amplitude, c.period, c.separation_velocity, c.multiplier})
     out += ',', append_number(out, cycle ? v : NAN);
   const bool computed = status == "limit_cycle" || status == "none" || status == "divergent" || status == "unresolved";
   out += ',', append_number(out, computed ? r.row.settle.time : NAN);
-  out += ',' + (computed ? r.row.settle.status : std::string());
-  return out + "\n";
+  out += ',';
+  if (computed) out += r.row.settle.status;
+  out += '\n';
+  return out;
 }
 
 std::string map_boundary_csv_header(const MapPlan& plan) {

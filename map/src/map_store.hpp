@@ -51,12 +51,15 @@ struct MapRecord {
 inline void append_record(std::string& out, const MapRow& r) {
   const std::int64_t head[2] = {r.index, map_status_code(api::status_of(r.row))};
   const std::int64_t word[2] = {head[0], head[1] | (r.row.cycle.survey_fallback ? map_survey_fallback_bit : 0)};
+  out.reserve(out.size() + MapRecord::size(r.x.size()));
   out.append(reinterpret_cast<const char*>(word), sizeof word);
   const numeric::Parameters& p = r.row.point.parameters;
   const numeric::Effects& e = r.row.point.effects;
   const bool cycle = head[1] == 0, computed = map_status_searched(head[1]);
   const numeric::LimitCycle& c = r.row.cycle;
-  std::vector<double> v = r.x;
+  std::vector<double> v;
+  v.reserve(r.x.size() + MapRecord::kValues);  // one allocation, the record's too
+  v.insert(v.end(), r.x.begin(), r.x.end());
   for (const double x : numeric::point_column_values(p, e)) v.push_back(x);
   for (const double x : {c.peak_to_peak, c.amplitude, c.period, c.separation_velocity, c.multiplier})
     v.push_back(cycle ? x : NAN);
