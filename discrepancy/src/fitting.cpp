@@ -78,7 +78,7 @@ void Simulator::keep(const std::string& key, std::shared_ptr<const Kept> kept) {
   cache_order_.push_back(key);
   if (cache_order_.size() > kKeptSimulations) {
     cache_.erase(cache_order_.front());
-    cache_order_.erase(cache_order_.begin());
+    cache_order_.pop_front();
   }
 }
 

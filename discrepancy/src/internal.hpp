@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <deque>
 #include <functional>
 #include <limits>
 #include <map>
@@ -144,7 +145,7 @@ class Simulator {
   void keep(const std::string& key, std::shared_ptr<const Kept> kept);
   std::mutex cache_mutex_;
   std::map<std::string, std::shared_ptr<const Kept>> cache_;  ///< the last simulations, by model point and length
-  std::vector<std::string> cache_order_;                    ///< oldest first
+  std::deque<std::string> cache_order_;                     ///< oldest first (the oldest leaves in O(1))
   std::map<std::string, std::weak_ptr<const Kept>> held_;   ///< hold()'s, while their handles live
   std::map<std::pair<std::size_t, Grid>, std::shared_ptr<const SampleGrid>> grids_;  ///< sample_grid()'s
   std::atomic<int> hits_{0};
