@@ -78,7 +78,7 @@ void Simulator::keep(const std::string& key, std::shared_ptr<const Kept> kept) {
   cache_order_.push_back(key);
   if (cache_order_.size() > kKeptSimulations) {
     cache_.erase(cache_order_.front());
-    cache_order_.erase(cache_order_.begin());
+    cache_order_.pop_front();
   }
 }
 
@@ -118,7 +118,7 @@ Simulator::Traces Simulator::traces(const ModelPoint& m, std::size_t samples, st
     work_ += kept->cost;
   } else {
     auto fresh = std::make_shared<Kept>();
-    fresh->traces = simulate(m, samples, rows(samples, grid), &fresh->events, &fresh->cost);
+    fresh->traces = simulate(m, samples, *sample_grid(samples, grid), &fresh->events, &fresh->cost);
     if (fresh->cost > 0) keep(key_of(m, samples, grid), fresh);
     kept = std::move(fresh);
   }
@@ -128,8 +128,24 @@ Simulator::Traces Simulator::traces(const ModelPoint& m, std::size_t samples, st
   return kept->traces;
 }
 
-Simulator::Traces Simulator::simulate(const ModelPoint& m, std::size_t samples, const std::vector<std::size_t>& rows,
+// The lengths a search asks for are few (a fit's horizons): the last kKeptGrids of them are kept.
+std::shared_ptr<const Simulator::SampleGrid> Simulator::sample_grid(std::size_t samples, Grid grid) {
+  constexpr std::size_t kKeptGrids = 64;
+  std::lock_guard<std::mutex> lock(cache_mutex_);
+  if (const auto found = grids_.find({samples, grid}); found != grids_.end()) return found->second;
+  auto fresh = std::make_shared<SampleGrid>();
+  fresh->rows = rows(samples, grid);
+  fresh->times.resize(fresh->rows.size());
+  for (std::size_t k = 0; k < fresh->rows.size(); ++k)
+    fresh->times[k] = data_.t[fresh->rows[k]] - step_time_;  // the model's clock starts at the step
+  if (grids_.size() >= kKeptGrids) grids_.clear();  // a grid in use stays with its handle
+  grids_.emplace(std::pair{samples, grid}, fresh);
+  return fresh;
+}
+
+Simulator::Traces Simulator::simulate(const ModelPoint& m, std::size_t samples, const SampleGrid& grid,
                                       std::vector<numeric::SimulationEvent>* events, long* cost) {
+  const std::vector<std::size_t>& rows = grid.rows;
   std::optional<numeric::ValidatedEffectModel> model = family_.at(m.p, m.e);
   if (!model) {
     prepare({m});
@@ -137,14 +153,15 @@ Simulator::Traces Simulator::simulate(const ModelPoint& m, std::size_t samples, 
     if (!model) return nullptr;
   }
   numeric::SimulationOptions o;
-  o.sample_times.resize(rows.size());
-  for (std::size_t k = 0; k < rows.size(); ++k) o.sample_times[k] = data_.t[rows[k]] - step_time_;  // the model's clock starts at the step
+  o.sample_times = grid.times;
   o.t_end = std::min(t_end_ - step_time_, o.sample_times.back()) + 1e-9;
   o.max_events = 20000;  // a fit's trial point that needs more (a stiff, barely damped mesh) is a failed point
   // The samples go straight into the traces (no list of full trajectory samples: on a long
   // record that list was most of the workflow's memory, per worker thread); the rows not sampled
   // stay NaN.
-  auto out = std::make_shared<std::vector<std::vector<double>>>(data_.which.size(), std::vector<double>(samples, NAN));
+  auto out = std::make_shared<std::vector<std::vector<double>>>();
+  out->reserve(data_.which.size());
+  for (std::size_t c = 0; c < data_.which.size(); ++c) out->emplace_back(samples, NAN);  // no column copied
   std::size_t filled = 0;
   auto keep = [&](const numeric::TrajectorySample& s) {
     if (filled < rows.size())

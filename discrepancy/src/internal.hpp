@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <cmath>
+#include <deque>
 #include <functional>
 #include <limits>
 #include <map>
@@ -132,13 +133,21 @@ class Simulator {
   /// rows(samples, grid).size() without forming them (a fit's grid is as long as the whole
   /// one exactly when it is the whole one).
   std::size_t row_count(std::size_t samples, Grid grid) const;
-  Traces simulate(const ModelPoint& m, std::size_t samples, const std::vector<std::size_t>& rows,
+  /// The rows a simulation of this length on this grid samples and their times on the model's
+  /// clock (from the step): formed once per length and grid, read by every simulation of them.
+  struct SampleGrid {
+    std::vector<std::size_t> rows;
+    std::vector<double> times;
+  };
+  std::shared_ptr<const SampleGrid> sample_grid(std::size_t samples, Grid grid);
+  Traces simulate(const ModelPoint& m, std::size_t samples, const SampleGrid& grid,
                   std::vector<numeric::SimulationEvent>* events, long* cost);
   void keep(const std::string& key, std::shared_ptr<const Kept> kept);
   std::mutex cache_mutex_;
   std::map<std::string, std::shared_ptr<const Kept>> cache_;  ///< the last simulations, by model point and length
-  std::vector<std::string> cache_order_;                    ///< oldest first
+  std::deque<std::string> cache_order_;                     ///< oldest first (the oldest leaves in O(1))
   std::map<std::string, std::weak_ptr<const Kept>> held_;   ///< hold()'s, while their handles live
+  std::map<std::pair<std::size_t, Grid>, std::shared_ptr<const SampleGrid>> grids_;  ///< sample_grid()'s
   std::atomic<int> hits_{0};
   const Observations& data_;
   double step_, t_end_, step_time_;

@@ -42,7 +42,7 @@ namespace odeint = boost::numeric::odeint;
 
 constexpr double tolerance = 1e-13;  // dopri5 absolute = relative error per step (1e-11 drifted 1e-10 s per s)
 constexpr int samples_per_step = 6;  // witness samples inside each step (plus its end)
-// Steps kept by one segment (for its states and extremes): 65536 steps of 272 bytes, 18 MB.
+// Steps kept by one segment (for its states and extremes): 65536 steps of 464 bytes, 30 MB.
 constexpr std::size_t max_segment_steps = 1 << 16;
 
 struct Jet {
@@ -78,6 +78,8 @@ class Quintic {
     return v;
   }
   double length() const { return h_; }
+  /// The coefficient of s^k in value_at_fraction(s).
+  double coefficient(int k) const { return a_[static_cast<std::size_t>(k)]; }
   Jet at(double t) const {
     if (h_ <= 0) return {a_[0], 0, 0};
     const double s = (t - t0_) / h_;
@@ -97,7 +99,15 @@ class Quintic {
 struct Step {
   double t0, t1;
   std::array<Quintic, 4> z;  // all on the same [t0, t0 + h]
+  /// z[i]'s coefficient of s^k at 4k + i (pack()): values() sums the four Horner schemes side by
+  /// side, each with the operations of z[i].value_at_fraction(s) in its order (the same bits).
+  alignas(16) std::array<double, 24> by_power{};
 
+  /// Fills by_power from z (once the step's quintics are set).
+  void pack() {
+    for (int k = 0; k < 6; ++k)
+      for (int i = 0; i < 4; ++i) by_power[static_cast<std::size_t>(4 * k + i)] = z[static_cast<std::size_t>(i)].coefficient(k);
+  }
   /// The first n coordinates at t, each z[i].value(t) (the fraction (t − t0)/h formed once).
   void values(double t, int n, SmallVector& out) const {
     if (!(z[0].length() > 0)) {
@@ -105,7 +115,11 @@ struct Step {
       return;
     }
     const double s = (t - z[0].start()) / z[0].length();
-    for (int i = 0; i < n; ++i) out(i) = z[i].value_at_fraction(s);
+    alignas(16) std::array<double, 4> v;
+    for (int i = 0; i < 4; ++i) v[i] = by_power[20 + i];
+    for (int k = 4; k >= 0; --k)
+      for (int i = 0; i < 4; ++i) v[i] = v[i] * s + by_power[static_cast<std::size_t>(4 * k + i)];
+    for (int i = 0; i < n; ++i) out(i) = v[i];
   }
   /// Coordinate i of values(t, n, ·) alone.
   double value(double t, int i) const {
@@ -644,10 +658,11 @@ class DelayedSegment final : public Segment {
       SmallVector zb(n_);
       for (int i = 0; i < n_; ++i) zb(i) = x[i];
       const auto [zb1, zb2] = derivatives(zb, t);
-      Step& step = steps_.emplace_back();  // built in place (272 bytes)
+      Step& step = steps_.emplace_back();  // built in place (464 bytes)
       step.t0 = ta;
       step.t1 = t;
       for (int i = 0; i < n_; ++i) step.z[i] = Quintic(ta, t, {za(i), za1(i), za2(i)}, {zb(i), zb1(i), zb2(i)});
+      step.pack();
       const double kept_until = check_step(steps_.back(), arming, tolerances);
       const Step& kept = steps_.back();
       const Jet je = kept.z[theta_o_index()].at(kept_until);  // θo's coordinate alone is recorded
